@@ -1,0 +1,28 @@
+#include "core/chi_square.hpp"
+
+#include <cmath>
+
+#include <boost/math/policies/policy.hpp>
+#include <boost/math/special_functions/gamma.hpp>
+
+namespace mpm {
+namespace {
+
+using namespace boost::math::policies;
+using NoThrow = policy<domain_error<errno_on_error>, pole_error<errno_on_error>, overflow_error<errno_on_error>,
+                       evaluation_error<errno_on_error>, promote_double<false>>;
+
+}  // namespace
+
+double chi_square_survival(double x, double dof) noexcept {
+  if (!(dof > 0.0) || std::isnan(x)) return NAN;
+  if (x <= 0.0) return 1.0;
+  return boost::math::gamma_q(dof / 2.0, x / 2.0, NoThrow());
+}
+
+double chi_square_quantile_upper(double alpha, double dof) noexcept {
+  if (!(dof > 0.0) || !(alpha > 0.0 && alpha < 1.0)) return NAN;
+  return 2.0 * boost::math::gamma_q_inv(dof / 2.0, alpha, NoThrow());
+}
+
+}  // namespace mpm

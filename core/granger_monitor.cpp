@@ -1,0 +1,249 @@
+#include "core/granger_monitor.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/chi_square.hpp"
+
+namespace mpm {
+namespace {
+
+constexpr double kRegularization = 1e-9;
+// Divergence: the residual's short-memory variance exceeds this many times
+// the quietest level it had (amplitude x ~30): the loop is not stationary and
+// a causality verdict on it would be meaningless (paper Sec. 4.2.4).
+constexpr double kDivergenceRatio = 1e3;
+constexpr double kFastMemory = 0.99;  // ~100-sample variance estimate
+
+bool finite_all(const double* v, std::size_t n) noexcept {
+  for (std::size_t i = 0; i < n; ++i)
+    if (!std::isfinite(v[i])) return false;
+  return true;
+}
+
+}  // namespace
+
+std::string MonitorSettings::validate() const {
+  std::ostringstream e;
+  if (ar_order < 0 || ar_order > 200) e << "ar_order must be in [0, 200], got " << ar_order << "; ";
+  if (input_order < 1 || input_order > 200) e << "input_order must be in [1, 200], got " << input_order << "; ";
+  if (!(forgetting > 0.9 && forgetting <= 1.0)) e << "forgetting must be in (0.9, 1], got " << forgetting << "; ";
+  if (!(false_alarm > 0.0 && false_alarm < 0.5)) e << "false_alarm must be in (0, 0.5), got " << false_alarm << "; ";
+  if (!(clear_ratio > 0.0 && clear_ratio <= 1.0)) e << "clear_ratio must be in (0, 1], got " << clear_ratio << "; ";
+  if (raise_after < 1) e << "raise_after must be >= 1, got " << raise_after << "; ";
+  if (clear_after < 1) e << "clear_after must be >= 1, got " << clear_after << "; ";
+  if (warmup < 0) e << "warmup must be >= 0, got " << warmup << "; ";
+  if (!(gamma_lambda > 0.0)) e << "gamma_lambda must be > 0, got " << gamma_lambda << "; ";
+  std::string s = e.str();
+  if (s.size() >= 2) s.resize(s.size() - 2);
+  return s;
+}
+
+GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, const MonitorSettings& settings,
+                               std::vector<std::optional<std::vector<double>>> n_inverse_ar)
+    : settings_(settings), n_inputs_(n_inputs), n_outputs_(n_outputs) {
+  if (const std::string err = settings.validate(); !err.empty()) throw std::invalid_argument(err);
+  if (n_inputs == 0 || n_outputs == 0) throw std::invalid_argument("monitor needs at least one input and one output");
+  if (!n_inverse_ar.empty() && n_inverse_ar.size() != n_outputs)
+    throw std::invalid_argument("noise models: need one entry per output");
+  na_ = static_cast<std::size_t>(settings.ar_order);
+  nb_ = static_cast<std::size_t>(settings.input_order);
+  const std::size_t p_full = n_regressors();
+  const std::size_t p_pair = 1 + na_ + nb_;
+  warmup_ = settings.warmup > 0 ? settings.warmup : static_cast<int>(10 * p_full);
+
+  full_.assign(n_outputs, SqrtRls(p_full, settings.forgetting, kRegularization));
+  pairwise_.assign(n_outputs * n_inputs, SqrtRls(p_pair, settings.forgetting, kRegularization));
+  residual_lags_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(na_), static_cast<Eigen::Index>(n_outputs));
+  input_lags_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nb_), static_cast<Eigen::Index>(n_inputs));
+  row_.resize(static_cast<Eigen::Index>(p_full));
+  pair_row_.resize(static_cast<Eigen::Index>(p_pair));
+  coef_.resize(static_cast<Eigen::Index>(p_full));
+  pair_coef_.resize(static_cast<Eigen::Index>(p_pair));
+  scratch_.resize(static_cast<Eigen::Index>(p_full + 1), static_cast<Eigen::Index>(p_full + 1));
+
+  n_inverse_ar_.resize(n_outputs);
+  for (std::size_t j = 0; j < n_inverse_ar.size(); ++j) {
+    if (!n_inverse_ar[j]) continue;
+    if (n_inverse_ar[j]->size() < na_)
+      throw std::invalid_argument("noise model AR coefficients shorter than ar_order");
+    n_inverse_ar_[j] = Eigen::Map<const Eigen::VectorXd>(n_inverse_ar[j]->data(), static_cast<Eigen::Index>(na_));
+  }
+  channels_.assign(n_outputs * n_inputs, ChannelStats{});
+  loops_.assign(n_outputs, LoopStats{});
+  mean_fast_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_outputs));
+  var_fast_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_outputs));
+  var_baseline_ = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(n_outputs), INFINITY);
+
+  const double dof = static_cast<double>(nb_);
+  lr_raise_ = chi_square_quantile_upper(settings.false_alarm, dof);
+  lr_clear_ = settings.clear_ratio * lr_raise_;
+  reset();
+}
+
+void GrangerMonitor::reset() noexcept {
+  for (auto& r : full_) r.reset();
+  for (auto& r : pairwise_) r.reset();
+  residual_lags_.setZero();
+  input_lags_.setZero();
+  lags_filled_ = 0;
+  in_gap_ = false;
+  sum_w_ = sum_w2_ = n_eq_ = 0.0;
+  std::fill(channels_.begin(), channels_.end(), ChannelStats{});
+  std::fill(loops_.begin(), loops_.end(), LoopStats{});
+  mean_fast_.setZero();
+  var_fast_.setZero();
+  var_baseline_.setConstant(INFINITY);
+  for (auto& c : channels_) c.gamma = NAN;
+  used_since_reset_ = 0;
+}
+
+bool GrangerMonitor::ready() const noexcept { return used_since_reset_ >= static_cast<std::uint64_t>(warmup_); }
+
+double GrangerMonitor::p_value(double lr) const noexcept {
+  return chi_square_survival(lr, static_cast<double>(nb_));
+}
+
+SampleStatus GrangerMonitor::update(const double* u, const double* residual) noexcept {
+  ++counters_.samples;
+  if (!finite_all(u, n_inputs_) || !finite_all(residual, n_outputs_)) {
+    // Skip the sample; the lag windows straddling it are invalid, so the
+    // regression restarts filling its lags after the gap.
+    ++counters_.missing;
+    if (!in_gap_) ++counters_.gaps;
+    in_gap_ = true;
+    lags_filled_ = 0;
+    return SampleStatus::kMissing;
+  }
+  in_gap_ = false;
+  SampleStatus status = SampleStatus::kWarmingUp;
+  if (lags_filled_ >= static_cast<int>(std::max(na_, nb_))) {
+    absorb_sample(residual);
+    ++counters_.used;
+    ++used_since_reset_;
+    update_divergence(residual);
+    update_statistics();
+    status = SampleStatus::kUsed;
+  }
+  push_lags(u, residual);
+  return status;
+}
+
+void GrangerMonitor::absorb_sample(const double* residual) noexcept {
+  const double lambda = settings_.forgetting;
+  sum_w_ = lambda * sum_w_ + 1.0;
+  sum_w2_ = lambda * lambda * sum_w2_ + 1.0;
+  n_eq_ = sum_w_ * sum_w_ / sum_w2_;
+
+  // Shared part of the full regressor row: intercept and every input's lags.
+  const auto na = static_cast<Eigen::Index>(na_);
+  const auto nb = static_cast<Eigen::Index>(nb_);
+  row_[0] = 1.0;
+  for (std::size_t i = 0; i < n_inputs_; ++i)
+    row_.segment(1 + na + static_cast<Eigen::Index>(i) * nb, nb) = input_lags_.col(static_cast<Eigen::Index>(i));
+  pair_row_[0] = 1.0;
+  for (std::size_t j = 0; j < n_outputs_; ++j) {
+    const auto jj = static_cast<Eigen::Index>(j);
+    row_.segment(1, na) = residual_lags_.col(jj);
+    full_[j].update(row_.data(), residual[j]);
+    pair_row_.segment(1, na) = residual_lags_.col(jj);
+    for (std::size_t i = 0; i < n_inputs_; ++i) {
+      pair_row_.segment(1 + na, nb) = input_lags_.col(static_cast<Eigen::Index>(i));
+      pairwise_[j * n_inputs_ + i].update(pair_row_.data(), residual[j]);
+    }
+  }
+}
+
+void GrangerMonitor::push_lags(const double* u, const double* residual) noexcept {
+  // Newest first: shift down by one, put time k on top (sizes are small).
+  for (Eigen::Index r = static_cast<Eigen::Index>(na_) - 1; r > 0; --r) residual_lags_.row(r) = residual_lags_.row(r - 1);
+  if (na_ > 0)
+    for (std::size_t j = 0; j < n_outputs_; ++j) residual_lags_(0, static_cast<Eigen::Index>(j)) = residual[j];
+  for (Eigen::Index r = static_cast<Eigen::Index>(nb_) - 1; r > 0; --r) input_lags_.row(r) = input_lags_.row(r - 1);
+  for (std::size_t i = 0; i < n_inputs_; ++i) input_lags_(0, static_cast<Eigen::Index>(i)) = u[i];
+  if (lags_filled_ < 1 << 30) ++lags_filled_;
+}
+
+void GrangerMonitor::update_divergence(const double* residual) noexcept {
+  for (std::size_t j = 0; j < n_outputs_; ++j) {
+    const auto jj = static_cast<Eigen::Index>(j);
+    const double dev = residual[j] - mean_fast_[jj];
+    mean_fast_[jj] += (1.0 - kFastMemory) * dev;
+    var_fast_[jj] = kFastMemory * var_fast_[jj] + (1.0 - kFastMemory) * dev * dev;
+    // The short-memory estimate is settled after a few hundred samples.
+    if (used_since_reset_ > 300) var_baseline_[jj] = std::min(var_baseline_[jj], var_fast_[jj]);
+    if (var_fast_[jj] > kDivergenceRatio * var_baseline_[jj]) loops_[j].diverging = true;
+  }
+}
+
+void GrangerMonitor::update_statistics() noexcept {
+  const std::size_t p_full = n_regressors();
+  const std::size_t p_pair = 1 + na_ + nb_;
+  const double scale_full = std::max(n_eq_ - static_cast<double>(p_full), 1.0);
+  const double scale_pair = std::max(n_eq_ - static_cast<double>(p_pair), 1.0);
+  const bool testing = ready();
+  for (std::size_t j = 0; j < n_outputs_; ++j) {
+    const SqrtRls& full = full_[j];
+    LoopStats& loop = loops_[j];
+    const double rss_full = full.rss();
+    loop.sigma1 = full.rss_prefix(1 + na_) / sum_w_;
+    loop.sigma_full = rss_full / sum_w_;
+    loop.residual_variance = full.rss_prefix(1) / sum_w_;
+    bool any_alarm = false;
+    for (std::size_t i = 0; i < n_inputs_; ++i) {
+      ChannelStats& c = channels_[j * n_inputs_ + i];
+      const double rss_without = full.rss_without(1 + na_ + i * nb_, nb_, scratch_);
+      c.f_conditional = std::log(rss_without / rss_full);
+      c.lr_conditional = scale_full * c.f_conditional;
+
+      const SqrtRls& pair = pairwise_[j * n_inputs_ + i];
+      const double rss_pair = pair.rss();
+      c.f_pairwise = std::log(pair.rss_prefix(1 + na_) / rss_pair);
+      c.lr_pairwise = scale_pair * c.f_pairwise;
+
+      if (n_inverse_ar_[j]) {
+        // gamma = ||g_hat - g_N||^2 / ||[1, -g_N]||^2: the distance between
+        // the fitted AR part and that of N^-1, relative to the whole N^-1
+        // polynomial (leading 1 included), so a white N (g_N = 0) is fine.
+        pair.solve_prefix(p_pair, pair_coef_);
+        const auto& g_n = *n_inverse_ar_[j];
+        const double dist = (pair_coef_.segment(1, static_cast<Eigen::Index>(na_)) - g_n).squaredNorm();
+        c.gamma = dist / (1.0 + g_n.squaredNorm());
+      }
+      if (testing) update_alarm(c);
+      if (loop.diverging) c.alarm = false;  // no verdict on a diverging loop
+      any_alarm = any_alarm || c.alarm;
+    }
+    loop.alarm = any_alarm;
+  }
+}
+
+void GrangerMonitor::update_alarm(ChannelStats& c) noexcept {
+  if (c.lr_conditional > lr_raise_) {
+    ++c.above;
+    c.below = 0;
+  } else if (c.lr_conditional < lr_clear_) {
+    ++c.below;
+    c.above = 0;
+  } else {  // in the hysteresis band: neither counter advances
+    c.above = 0;
+    c.below = 0;
+  }
+  if (!c.alarm && c.above >= settings_.raise_after) c.alarm = true;
+  if (c.alarm && c.below >= settings_.clear_after) c.alarm = false;
+}
+
+void GrangerMonitor::full_coefficients(std::size_t output, Eigen::Ref<Eigen::VectorXd> out) const noexcept {
+  full_[output].solve_prefix(n_regressors(), out);
+}
+
+void GrangerMonitor::pairwise_ar_coefficients(std::size_t output, std::size_t input,
+                                              Eigen::Ref<Eigen::VectorXd> out) const noexcept {
+  // out: na values. Solve the pairwise model into scratch, copy the AR part.
+  pairwise_[output * n_inputs_ + input].solve_prefix(1 + na_ + nb_, pair_coef_);
+  out.head(static_cast<Eigen::Index>(na_)) = pair_coef_.segment(1, static_cast<Eigen::Index>(na_));
+}
+
+}  // namespace mpm

@@ -1,0 +1,182 @@
+// OVERVIEW
+// Online Granger-causality monitor of model-plant mismatch (Chen, Xie & Su,
+// Processes 2021, 9, 1976), one sample at a time, in fixed memory.
+//
+// For each output j the residual d~_j(k) is regressed on
+//   [1, d~_j(k-1..k-na), u_1(k-1..k-nb), ..., u_m(k-1..k-nb)]
+// by square-root recursive least squares with exponential forgetting (see
+// sqrt_rls.hpp). From that one factor per output come
+//   * the AR-only residual variance Sigma1 and the full-model variance,
+//   * the conditional Granger index of every input (all other inputs kept),
+//     F_c(u_i -> d~_j) = ln(RSS without u_i / RSS full),
+// and from one small factor per (output, input) pair, [1, AR, u_i],
+//   * the paper's pairwise index F(u_i -> d~_j) = ln(Sigma1 / Sigma2),
+//   * the AR coefficients the paper compares with N^-1: gamma(u_i -> d~_j).
+//
+// Tests: each index becomes a likelihood-ratio statistic LR = n_eq * F,
+// chi-square with nb degrees of freedom under "no causality", where n_eq =
+// (sum w)^2 / sum w^2 is the equivalent sample count of the forgetting
+// weights (= n for lambda = 1). The alarm threshold is precomputed at setup
+// from the per-channel false-alarm probability, so the hot path compares
+// numbers; p-values are computed on request (publishing, reports).
+//
+// Alarms: a channel is raised when its conditional LR exceeds the threshold
+// for `raise_after` consecutive samples, cleared when it stays below the
+// clear threshold (a lower, hysteresis level) for `clear_after` samples.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "core/sqrt_rls.hpp"
+
+namespace mpm {
+
+struct MonitorSettings {
+  int ar_order = 10;             // na: lags of the residual
+  int input_order = 10;          // nb: lags of each input
+  double forgetting = 0.999;     // lambda in (0, 1]; 1 = growing window
+  double false_alarm = 1e-3;     // per-channel, per-test probability alpha of
+                                 // exceeding the raise threshold under H0
+  double clear_ratio = 0.5;      // clear threshold = clear_ratio * raise threshold
+  int raise_after = 20;          // consecutive samples above to raise
+  int clear_after = 100;         // consecutive samples below to clear
+  int warmup = 0;                // samples before any test (0 = automatic:
+                                 // 10 x number of regressors)
+  double gamma_lambda = 0.1;     // paper's lambda: gamma < lambda^2 locates
+
+  // Empty string when valid, else what is wrong (names the field and range).
+  std::string validate() const;
+};
+
+// What one update did with a sample.
+enum class SampleStatus : std::uint8_t {
+  kUsed,        // entered the statistics
+  kMissing,     // a NaN/inf in u or residual: skipped, lags restart after it
+  kWarmingUp,   // filled lags only (after start or a gap)
+};
+
+struct ChannelStats {
+  double f_pairwise = 0.0;     // ln(Sigma1 / Sigma2), paper's index
+  double f_conditional = 0.0;  // ln(RSS without u_i / RSS full)
+  double lr_pairwise = 0.0;    // n_eq * f_pairwise
+  double lr_conditional = 0.0; // n_eq * f_conditional
+  double gamma = 0.0;          // noise-model index (NaN when N is unknown)
+  bool alarm = false;
+  int above = 0;               // consecutive samples above the raise level
+  int below = 0;               // consecutive samples below the clear level
+};
+
+struct LoopStats {
+  double sigma1 = 0.0;           // AR-only residual variance (weighted)
+  double sigma_full = 0.0;       // full-model residual variance (weighted)
+  double residual_variance = 0.0;// weighted variance of d~ about its mean
+  bool alarm = false;            // any channel of this output raised
+  bool diverging = false;        // residual variance growing without bound
+};
+
+struct MonitorCounters {
+  std::uint64_t samples = 0;     // update() calls
+  std::uint64_t used = 0;        // samples that entered the statistics
+  std::uint64_t missing = 0;     // samples with NaN/inf skipped
+  std::uint64_t gaps = 0;        // runs of missing samples
+};
+
+class GrangerMonitor {
+ public:
+  // Allocates everything. `n_inverse_ar[j]`, when given, holds the coefficients
+  // of 1 - N_j^-1 (noise_filter.hpp) for output j, at least ar_order long;
+  // without it gamma is NaN for that output. Throws std::invalid_argument on
+  // invalid settings or sizes.
+  GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, const MonitorSettings& settings,
+                 std::vector<std::optional<std::vector<double>>> n_inverse_ar = {});
+
+  // Real-time safe: no allocation, no exceptions. u: n_inputs values at time
+  // k, residual: n_outputs values of d~ at time k. Returns what was done.
+  SampleStatus update(const double* u, const double* residual) noexcept;
+
+  // Statistics as of the last update (refreshed every used sample).
+  const ChannelStats& channel(std::size_t output, std::size_t input) const noexcept {
+    return channels_[output * n_inputs_ + input];
+  }
+  const LoopStats& loop(std::size_t output) const noexcept { return loops_[output]; }
+  const MonitorCounters& counters() const noexcept { return counters_; }
+
+  // Equivalent sample count behind the current statistics.
+  double effective_samples() const noexcept { return n_eq_; }
+  double raise_threshold() const noexcept { return lr_raise_; }
+  double clear_threshold() const noexcept { return lr_clear_; }
+  bool ready() const noexcept;  // warm-up over
+
+  // p-value of an LR statistic under H0 (chi-square, nb dof). Not for the hot
+  // path (evaluates an incomplete gamma function), but allocation free.
+  double p_value(double lr) const noexcept;
+
+  // Full-model coefficients of output j: [intercept, AR (na), u_1 (nb), ...].
+  // Allocation free; writes into `out` (size n_regressors()).
+  void full_coefficients(std::size_t output, Eigen::Ref<Eigen::VectorXd> out) const noexcept;
+  // AR coefficients of the pairwise model [1, AR, u_i] of (output, input).
+  void pairwise_ar_coefficients(std::size_t output, std::size_t input,
+                                Eigen::Ref<Eigen::VectorXd> out) const noexcept;
+
+  std::size_t n_inputs() const noexcept { return n_inputs_; }
+  std::size_t n_outputs() const noexcept { return n_outputs_; }
+  std::size_t n_regressors() const noexcept { return 1 + na_ + n_inputs_ * nb_; }
+  const MonitorSettings& settings() const noexcept { return settings_; }
+
+  // Forgets everything learnt: statistics, lags, alarms (counters are kept).
+  void reset() noexcept;
+
+ private:
+  void absorb_sample(const double* residual) noexcept;
+  void push_lags(const double* u, const double* residual) noexcept;
+  void update_statistics() noexcept;
+  void update_alarm(ChannelStats& c) noexcept;
+  void update_divergence(const double* residual) noexcept;
+
+  MonitorSettings settings_;
+  std::size_t n_inputs_;
+  std::size_t n_outputs_;
+  std::size_t na_;
+  std::size_t nb_;
+  int warmup_;
+
+  // Lag histories, newest first: residual lags per output (na_ each),
+  // input lags per input (nb_ each). Shifted in place each sample.
+  Eigen::MatrixXd residual_lags_;  // na_ x n_outputs
+  Eigen::MatrixXd input_lags_;     // nb_ x n_inputs
+  int lags_filled_ = 0;            // valid consecutive samples in the lags
+
+  std::vector<SqrtRls> full_;      // one per output
+  std::vector<SqrtRls> pairwise_;  // output-major, one per (output, input)
+  Eigen::VectorXd row_;            // scratch regressor row (full)
+  Eigen::VectorXd pair_row_;       // scratch regressor row (pairwise)
+  Eigen::VectorXd coef_;           // scratch coefficients (full)
+  mutable Eigen::VectorXd pair_coef_;  // scratch coefficients (pairwise)
+  SqrtRls::Matrix scratch_;        // scratch for conditional RSS
+
+  std::vector<std::optional<Eigen::VectorXd>> n_inverse_ar_;
+  std::vector<ChannelStats> channels_;
+  std::vector<LoopStats> loops_;
+  MonitorCounters counters_;
+  bool in_gap_ = false;
+  std::uint64_t used_since_reset_ = 0;
+
+  double sum_w_ = 0.0;   // sum of forgetting weights
+  double sum_w2_ = 0.0;  // sum of squared weights
+  double n_eq_ = 0.0;
+  double lr_raise_ = 0.0;
+  double lr_clear_ = 0.0;
+  // Divergence detection per output: running mean and variance of d~ with a
+  // short memory, and the quietest variance seen (the baseline).
+  Eigen::VectorXd mean_fast_;
+  Eigen::VectorXd var_fast_;
+  Eigen::VectorXd var_baseline_;
+};
+
+}  // namespace mpm

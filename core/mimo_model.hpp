@@ -1,0 +1,60 @@
+// The nominal model G_M as a bank of channel filters, and the IMC residual
+// d~ = y - G_M u that the monitor watches.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "core/plant_model.hpp"
+#include "core/transfer_function.hpp"
+
+namespace mpm {
+
+// Steps every channel of a PlantModel on deviation inputs. Storage is sized in
+// the constructor; step() is real-time safe.
+class MimoModel {
+ public:
+  MimoModel() = default;
+  explicit MimoModel(const PlantModel& plant);
+
+  std::size_t n_inputs() const noexcept { return n_inputs_; }
+  std::size_t n_outputs() const noexcept { return n_outputs_; }
+
+  // u: n_inputs deviation inputs at time k; y: n_outputs model outputs at k.
+  void step(const double* u, double* y) noexcept;
+  // Back to rest at zero deviation.
+  void reset() noexcept;
+
+ private:
+  struct Channel {
+    std::size_t output;
+    std::size_t input;
+    DiscreteFilter filter;
+  };
+  std::size_t n_inputs_ = 0;
+  std::size_t n_outputs_ = 0;
+  std::vector<Channel> channels_;
+};
+
+// Computes the IMC residual from absolute-unit samples: deviation inputs
+// u - u0 go through G_M; the residual is y - G_M(u - u0) (the outputs' offset
+// stays in it; the monitor's regression has an intercept for it).
+class ResidualGenerator {
+ public:
+  ResidualGenerator() = default;
+  ResidualGenerator(const PlantModel& plant, std::vector<double> input_operating_point);
+
+  // u, y: absolute values at time k; residual: n_outputs values written.
+  // A NaN in u makes the affected outputs' residuals NaN at k; the model
+  // holds the last good input value for that input (zero-order hold).
+  void step(const double* u, const double* y, double* residual) noexcept;
+
+ private:
+  MimoModel model_;
+  std::vector<double> u0_;
+  std::vector<double> du_;
+  std::vector<double> y_model_;
+  std::vector<double> last_good_u_;
+};
+
+}  // namespace mpm
