@@ -35,6 +35,7 @@ std::string MonitorSettings::validate() const {
   if (raise_after < 1) e << "raise_after must be >= 1, got " << raise_after << "; ";
   if (clear_after < 1) e << "clear_after must be >= 1, got " << clear_after << "; ";
   if (warmup < 0) e << "warmup must be >= 0, got " << warmup << "; ";
+  if (!(input_pole >= 0.0 && input_pole < 0.99)) e << "input_pole must be in [0, 0.99), got " << input_pole << "; ";
   if (!(gamma_lambda > 0.0)) e << "gamma_lambda must be > 0, got " << gamma_lambda << "; ";
   std::string s = e.str();
   if (s.size() >= 2) s.resize(s.size() - 2);
@@ -52,12 +53,19 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   nb_ = static_cast<std::size_t>(settings.input_order);
   const std::size_t p_full = n_regressors();
   const std::size_t p_pair = 1 + na_ + nb_;
+  // After a start or a gap, the residual lags need na samples; the Laguerre
+  // states need nb samples and then until the pre-gap memory (zeroed) has
+  // decayed to 1 %.
+  lags_needed_ = static_cast<int>(std::max(na_, nb_));
+  if (settings.input_pole > 0.0)
+    lags_needed_ = std::max(lags_needed_, static_cast<int>(nb_) + static_cast<int>(std::ceil(std::log(0.01) / std::log(settings.input_pole))));
   warmup_ = settings.warmup > 0 ? settings.warmup : static_cast<int>(10 * p_full);
 
   full_.assign(n_outputs, SqrtRls(p_full, settings.forgetting, kRegularization));
   pairwise_.assign(n_outputs * n_inputs, SqrtRls(p_pair, settings.forgetting, kRegularization));
   residual_lags_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(na_), static_cast<Eigen::Index>(n_outputs));
   input_lags_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nb_), static_cast<Eigen::Index>(n_inputs));
+  input_ref_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_inputs));
   row_.resize(static_cast<Eigen::Index>(p_full));
   pair_row_.resize(static_cast<Eigen::Index>(p_pair));
   coef_.resize(static_cast<Eigen::Index>(p_full));
@@ -115,11 +123,15 @@ SampleStatus GrangerMonitor::update(const double* u, const double* residual) noe
     if (!in_gap_) ++counters_.gaps;
     in_gap_ = true;
     lags_filled_ = 0;
+    input_lags_.setZero();
     return SampleStatus::kMissing;
   }
   in_gap_ = false;
+  if (lags_filled_ == 0) {  // (re)start: the basis starts at rest at this level
+    for (std::size_t i = 0; i < n_inputs_; ++i) input_ref_[static_cast<Eigen::Index>(i)] = u[i];
+  }
   SampleStatus status = SampleStatus::kWarmingUp;
-  if (lags_filled_ >= static_cast<int>(std::max(na_, nb_))) {
+  if (lags_filled_ >= lags_needed_) {
     absorb_sample(residual);
     ++counters_.used;
     ++used_since_reset_;
@@ -161,8 +173,20 @@ void GrangerMonitor::push_lags(const double* u, const double* residual) noexcept
   for (Eigen::Index r = static_cast<Eigen::Index>(na_) - 1; r > 0; --r) residual_lags_.row(r) = residual_lags_.row(r - 1);
   if (na_ > 0)
     for (std::size_t j = 0; j < n_outputs_; ++j) residual_lags_(0, static_cast<Eigen::Index>(j)) = residual[j];
-  for (Eigen::Index r = static_cast<Eigen::Index>(nb_) - 1; r > 0; --r) input_lags_.row(r) = input_lags_.row(r - 1);
-  for (std::size_t i = 0; i < n_inputs_; ++i) input_lags_(0, static_cast<Eigen::Index>(i)) = u[i];
+  // Laguerre network, one column per input: x_1 <- a x_1 + sqrt(1-a^2) u(k),
+  // x_r <- a x_r + x_{r-1}(old) - a x_{r-1}(new). With a = 0: a shift register.
+  const double a = settings_.input_pole;
+  const double gain = std::sqrt(1.0 - a * a);
+  for (std::size_t i = 0; i < n_inputs_; ++i) {
+    double* x = input_lags_.col(static_cast<Eigen::Index>(i)).data();
+    double prev_old = x[0];
+    x[0] = a * x[0] + gain * (u[i] - input_ref_[static_cast<Eigen::Index>(i)]);
+    for (std::size_t r = 1; r < nb_; ++r) {
+      const double old = x[r];
+      x[r] = a * x[r] + prev_old - a * x[r - 1];
+      prev_old = old;
+    }
+  }
   if (lags_filled_ < 1 << 30) ++lags_filled_;
 }
 

@@ -3,7 +3,12 @@
 // Processes 2021, 9, 1976), one sample at a time, in fixed memory.
 //
 // For each output j the residual d~_j(k) is regressed on
-//   [1, d~_j(k-1..k-na), u_1(k-1..k-nb), ..., u_m(k-1..k-nb)]
+//   [1, d~_j(k-1..k-na), L(q) u_1(k), ..., L(q) u_m(k)]
+// where L(q) is a bank of nb orthonormal Laguerre filters with pole a, each
+// with at least one sample of delay; a = 0 gives the paper's plain lags
+// u_i(k-1..k-nb). A slow process has responses far longer than nb samples;
+// with a near its dominant pole the same nb regressors cover them, which is
+// what makes small, concealed mismatches detectable in a few thousand samples.
 // by square-root recursive least squares with exponential forgetting (see
 // sqrt_rls.hpp). From that one factor per output come
 //   * the AR-only residual variance Sigma1 and the full-model variance,
@@ -39,7 +44,11 @@ namespace mpm {
 
 struct MonitorSettings {
   int ar_order = 10;             // na: lags of the residual
-  int input_order = 10;          // nb: lags of each input
+  int input_order = 10;          // nb: lags (basis functions) of each input
+  double input_pole = 0.0;       // Laguerre pole a in [0, 0.99) of the input
+                                 // basis: 0 = plain lags u(k-1..k-nb), as in the
+                                 // paper; near the process's dominant pole, nb
+                                 // functions span a memory of ~nb/(1-a) samples
   double forgetting = 0.999;     // lambda in (0, 1]; 1 = growing window
   double false_alarm = 1e-3;     // per-channel, per-test probability alpha of
                                  // exceeding the raise threshold under H0
@@ -146,11 +155,14 @@ class GrangerMonitor {
   std::size_t nb_;
   int warmup_;
 
-  // Lag histories, newest first: residual lags per output (na_ each),
-  // input lags per input (nb_ each). Shifted in place each sample.
+  // Residual lags per output, newest first (na_ each), shifted each sample;
+  // Laguerre states per input (nb_ each), regressors for the next sample.
   Eigen::MatrixXd residual_lags_;  // na_ x n_outputs
   Eigen::MatrixXd input_lags_;     // nb_ x n_inputs
   int lags_filled_ = 0;            // valid consecutive samples in the lags
+  int lags_needed_ = 0;            // samples to fill lags / settle the basis
+  Eigen::VectorXd input_ref_;      // input level at (re)start: the basis sees
+                                   // u - input_ref_, so its zero state is at rest
 
   std::vector<SqrtRls> full_;      // one per output
   std::vector<SqrtRls> pairwise_;  // output-major, one per (output, input)

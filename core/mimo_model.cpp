@@ -51,3 +51,35 @@ void ResidualGenerator::step(const double* u, const double* y, double* residual)
 }
 
 }  // namespace mpm
+
+namespace mpm {
+
+std::size_t settling_samples(const PlantModel& plant, double fraction, std::size_t cap) {
+  std::size_t worst = 0;
+  for (const auto& c : plant.channels) {
+    if (c.tf.is_zero()) continue;
+    double slowest = 0.0;
+    for (double m : root_magnitudes(c.tf.den)) slowest = std::max(slowest, m);
+    if (slowest >= 1.0) return cap;
+    std::size_t n = static_cast<std::size_t>(c.tf.delay) + c.tf.num.size();
+    if (slowest > 0.0) n += static_cast<std::size_t>(std::ceil(std::log(fraction) / std::log(slowest)));
+    worst = std::max(worst, n);
+  }
+  return std::min(worst, cap);
+}
+
+}  // namespace mpm
+
+namespace mpm {
+
+double dominant_pole(const PlantModel& plant, double cap) {
+  double slowest = 0.0;
+  for (const auto& c : plant.channels) {
+    if (c.tf.is_zero()) continue;
+    for (double m : root_magnitudes(c.tf.den))
+      if (m < 1.0 - 1e-9) slowest = std::max(slowest, m);
+  }
+  return std::min(slowest, cap);
+}
+
+}  // namespace mpm

@@ -58,3 +58,22 @@ class ResidualGenerator {
 };
 
 }  // namespace mpm
+
+namespace mpm {
+
+// Samples after which every channel's response to past inputs has decayed to
+// `fraction` of its initial size (slowest pole), plus the longest delay: how
+// long the residual of a model started from rest carries a start-up
+// transient. Integrating or unstable channels never settle: `cap` is returned.
+std::size_t settling_samples(const PlantModel& plant, double fraction, std::size_t cap);
+
+}  // namespace mpm
+
+namespace mpm {
+
+// A Laguerre pole for the monitor's input basis matched to the plant: the
+// slowest stable real pole magnitude among the model's channels, capped at
+// `cap` (0 when the model has only static or integrating channels).
+double dominant_pole(const PlantModel& plant, double cap = 0.98);
+
+}  // namespace mpm
