@@ -12,8 +12,10 @@ namespace {
 
 constexpr double kRegularization = 1e-9;
 // Divergence: the residual's short-memory variance exceeds this many times
-// the quietest level it had (amplitude x ~30): the loop is not stationary and
-// a causality verdict on it would be meaningless (paper Sec. 4.2.4).
+// the matched-model variance (amplitude x 10), or, where that is unknown,
+// 1000 times the quietest level it had: the loop is not stationary and a
+// causality verdict on it would be meaningless (paper Sec. 4.2.4).
+constexpr double kDivergenceOverReference = 100.0;
 constexpr double kDivergenceRatio = 1e3;
 constexpr double kFastMemory = 0.99;  // ~100-sample variance estimate
 
@@ -43,7 +45,8 @@ std::string MonitorSettings::validate() const {
 }
 
 GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, const MonitorSettings& settings,
-                               std::vector<std::optional<std::vector<double>>> n_inverse_ar)
+                               std::vector<std::optional<std::vector<double>>> n_inverse_ar,
+                               std::vector<double> reference_variance)
     : settings_(settings), n_inputs_(n_inputs), n_outputs_(n_outputs) {
   if (const std::string err = settings.validate(); !err.empty()) throw std::invalid_argument(err);
   if (n_inputs == 0 || n_outputs == 0) throw std::invalid_argument("monitor needs at least one input and one output");
@@ -84,6 +87,12 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   mean_fast_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_outputs));
   var_fast_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_outputs));
   var_baseline_ = Eigen::VectorXd::Constant(static_cast<Eigen::Index>(n_outputs), INFINITY);
+  if (!reference_variance.empty() && reference_variance.size() != n_outputs)
+    throw std::invalid_argument("reference variance: need one entry per output");
+  var_reference_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_outputs));
+  for (std::size_t j = 0; j < reference_variance.size(); ++j)
+    if (std::isfinite(reference_variance[j]) && reference_variance[j] > 0.0)
+      var_reference_[static_cast<Eigen::Index>(j)] = reference_variance[j];
 
   const double dof = static_cast<double>(nb_);
   lr_raise_ = chi_square_quantile_upper(settings.false_alarm, dof);
@@ -199,6 +208,9 @@ void GrangerMonitor::update_divergence(const double* residual) noexcept {
     // The short-memory estimate is settled after a few hundred samples.
     if (used_since_reset_ > 300) var_baseline_[jj] = std::min(var_baseline_[jj], var_fast_[jj]);
     if (var_fast_[jj] > kDivergenceRatio * var_baseline_[jj]) loops_[j].diverging = true;
+    if (var_reference_[jj] > 0.0 && used_since_reset_ > 100 &&
+        var_fast_[jj] > kDivergenceOverReference * var_reference_[jj])
+      loops_[j].diverging = true;
   }
 }
 

@@ -100,10 +100,13 @@ class GrangerMonitor {
  public:
   // Allocates everything. `n_inverse_ar[j]`, when given, holds the coefficients
   // of 1 - N_j^-1 (noise_filter.hpp) for output j, at least ar_order long;
-  // without it gamma is NaN for that output. Throws std::invalid_argument on
-  // invalid settings or sizes.
+  // without it gamma is NaN for that output. `reference_variance[j]`, when
+  // given and > 0, is the variance the residual of output j has with a
+  // matched model (N's output variance): a residual far above it means the
+  // loop diverges. Throws std::invalid_argument on invalid settings or sizes.
   GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, const MonitorSettings& settings,
-                 std::vector<std::optional<std::vector<double>>> n_inverse_ar = {});
+                 std::vector<std::optional<std::vector<double>>> n_inverse_ar = {},
+                 std::vector<double> reference_variance = {});
 
   // Real-time safe: no allocation, no exceptions. u: n_inputs values at time
   // k, residual: n_outputs values of d~ at time k. Returns what was done.
@@ -189,6 +192,7 @@ class GrangerMonitor {
   Eigen::VectorXd mean_fast_;
   Eigen::VectorXd var_fast_;
   Eigen::VectorXd var_baseline_;
+  Eigen::VectorXd var_reference_;  // from the noise model; 0 = unknown
 };
 
 }  // namespace mpm

@@ -21,6 +21,18 @@ DiscreteTf inverse(const DiscreteTf& n) {
   return inv;
 }
 
+double noise_output_variance(const DiscreteTf& n, double a_variance) {
+  if (!n.is_stable()) return INFINITY;
+  DiscreteFilter f(n);
+  double energy = 0.0;
+  for (int k = 0; k < 1'000'000; ++k) {
+    const double h = f.step(k == 0 ? 1.0 : 0.0);
+    energy += h * h;
+    if (k > static_cast<int>(n.num.size() + n.den.size()) + n.delay && h * h < 1e-14 * energy) break;
+  }
+  return a_variance * energy;
+}
+
 std::vector<double> inverse_noise_ar_coefficients(const DiscreteTf& n, int order) {
   if (order < 0) throw std::invalid_argument("order must be >= 0");
   DiscreteFilter inv(inverse(n));

@@ -15,6 +15,10 @@ namespace mpm {
 // N^-1 is unstable (N non-minimum-phase).
 std::vector<double> inverse_noise_ar_coefficients(const DiscreteTf& n, int order);
 
+// Variance of d = N a for white a of the given variance (sum of the squared
+// impulse response of N, to 1e-12 relative). +inf if N is not stable.
+double noise_output_variance(const DiscreteTf& n, double a_variance);
+
 // N^-1 = den/num as a filter. Same preconditions as above.
 DiscreteTf inverse(const DiscreteTf& n);
 

@@ -106,7 +106,7 @@ int run(int argc, char** argv) {
     const config::BoundRecording bound = config::bind(plant, rec);
     const ResidualSeries series = compute_residuals(plant, rec, bound);
 
-    GrangerMonitor monitor(plant.n_inputs(), plant.n_outputs(), settings, noise_ar(plant, settings.ar_order));
+    GrangerMonitor monitor(plant.n_inputs(), plant.n_outputs(), settings, noise_ar(plant, settings.ar_order), reference_variances(plant));
     std::vector<ChannelTrace> trace(plant.n_inputs() * plant.n_outputs());
     run_monitor(monitor, series, [&](std::size_t k, const GrangerMonitor& m) {
       for (std::size_t j = 0; j < m.n_outputs(); ++j)

@@ -56,4 +56,11 @@ std::vector<std::optional<std::vector<double>>> noise_ar(const PlantModel& plant
   return out;
 }
 
+std::vector<double> reference_variances(const PlantModel& plant) {
+  std::vector<double> out(plant.n_outputs(), 0.0);
+  for (std::size_t j = 0; j < plant.n_outputs() && j < plant.noise.size(); ++j)
+    if (plant.noise[j] && plant.noise[j]->variance) out[j] = noise_output_variance(plant.noise[j]->tf, *plant.noise[j]->variance);
+  return out;
+}
+
 }  // namespace mpm

@@ -30,6 +30,10 @@ ResidualSeries compute_residuals(const PlantModel& plant, const config::Recordin
 // Noise-model AR coefficients (1 - N^-1) per output, for the gamma index.
 std::vector<std::optional<std::vector<double>>> noise_ar(const PlantModel& plant, int order);
 
+// Variance of each output's residual with a matched model (N's output
+// variance), 0 where the plant file gives no noise model or no variance.
+std::vector<double> reference_variances(const PlantModel& plant);
+
 // Runs the online monitor over the series (after the transient), calling
 // `on_sample(k, monitor)` after each update when given.
 template <typename OnSample>

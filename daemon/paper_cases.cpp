@@ -45,7 +45,7 @@ PaperCaseResult run_paper_case(const std::string& scenario, std::uint64_t seed, 
   const config::BoundRecording bound = config::bind(plant, rec);
   const ResidualSeries series = compute_residuals(plant, rec, bound);
   PaperCaseResult out{plant, GrangerMonitor(plant.n_inputs(), plant.n_outputs(), settings,
-                                            noise_ar(plant, settings.ar_order)),
+                                            noise_ar(plant, settings.ar_order), reference_variances(plant)),
                       {}, {}, false, rec.samples()};
   run_monitor(out.monitor, series, [](std::size_t, const GrangerMonitor&) {});
   for (std::size_t j = 0; j < plant.n_outputs(); ++j) {

@@ -1,0 +1,150 @@
+#include "config/daemon_config.hpp"
+
+#include <filesystem>
+
+#include "config/file_text.hpp"
+#include "config/plant_loader.hpp"
+#include "config/yaml_reader.hpp"
+
+namespace mpm::config {
+namespace {
+
+using detail::Field;
+using detail::YamlReader;
+
+ConfigError yaml_error(const YAML::Exception& e, const std::string& source, const char* what) {
+  const std::string where =
+      e.mark.is_null() ? "" : std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ":";
+  return ConfigError(source + ":" + where + " " + what + ": " + e.msg);
+}
+
+std::string resolve(const std::string& path, const std::string& base_dir) {
+  if (path.empty() || base_dir.empty() || std::filesystem::path(path).is_absolute()) return path;
+  return (std::filesystem::path(base_dir) / path).lexically_normal().string();
+}
+
+// Optional scalars: read only when the key is present.
+void read(const YamlReader& r, const Field& map, const char* key, int& out) {
+  const Field f = r.child(map, key);
+  if (f.present()) out = r.integer(f);
+}
+void read(const YamlReader& r, const Field& map, const char* key, double& out) {
+  const Field f = r.child(map, key);
+  if (f.present()) out = r.number(f);
+}
+void read(const YamlReader& r, const Field& map, const char* key, std::string& out) {
+  const Field f = r.child(map, key);
+  if (f.present()) out = r.name(f);
+}
+
+void read_monitor(const YamlReader& r, const Field& root, DaemonConfig& c) {
+  const Field m = r.child(root, "monitor");
+  if (!m.present() || m.node.IsNull()) return;
+  r.check_keys(m, {"ar_order", "input_order", "forgetting", "false_alarm", "clear_ratio", "raise_after",
+                   "clear_after", "warmup", "gamma_lambda", "settle_samples"});
+  MonitorSettings& s = c.monitor;
+  read(r, m, "ar_order", s.ar_order);
+  read(r, m, "input_order", s.input_order);
+  read(r, m, "forgetting", s.forgetting);
+  read(r, m, "false_alarm", s.false_alarm);
+  read(r, m, "clear_ratio", s.clear_ratio);
+  read(r, m, "raise_after", s.raise_after);
+  read(r, m, "clear_after", s.clear_after);
+  read(r, m, "warmup", s.warmup);
+  read(r, m, "gamma_lambda", s.gamma_lambda);
+  const Field settle = r.child(m, "settle_samples");
+  if (settle.present() && !(settle.node.IsScalar() && settle.node.Scalar() == "auto")) {
+    c.settle_samples = r.integer(settle);
+    if (c.settle_samples < 0) r.fail(settle, "expected \"auto\" or a number of samples >= 0");
+  }
+  if (const std::string problem = s.validate(); !problem.empty()) r.fail(m, problem);
+}
+
+void read_lcm(const YamlReader& r, const Field& t, transport::LcmSettings& lcm) {
+  const Field f = r.child(t, "lcm");
+  if (!f.present() || f.node.IsNull()) return;
+  r.check_keys(f, {"url", "sample_channel", "alarm_channel", "status_channel"});
+  read(r, f, "url", lcm.url);
+  read(r, f, "sample_channel", lcm.sample_channel);
+  read(r, f, "alarm_channel", lcm.alarm_channel);
+  read(r, f, "status_channel", lcm.status_channel);
+}
+
+void read_dds(const YamlReader& r, const Field& t, const std::string& base_dir, transport::DdsSettings& dds) {
+  const Field f = r.child(t, "dds");
+  if (!f.present() || f.node.IsNull()) return;
+  r.check_keys(f, {"domain", "config", "sample_topic", "alarm_topic", "status_topic", "sample_history"});
+  read(r, f, "domain", dds.domain);
+  if (dds.domain < 0 || dds.domain > 230) r.fail(r.child(f, "domain"), "expected a DDS domain id in 0..230");
+  read(r, f, "config", dds.config);
+  // A path to an XML file is relative to this file; inline XML and URIs are kept.
+  if (!dds.config.empty() && dds.config.front() != '<' && dds.config.find("://") == std::string::npos) {
+    dds.config = resolve(dds.config, base_dir);
+    if (!std::filesystem::exists(dds.config))
+      r.fail(r.child(f, "config"), "no such Cyclone DDS configuration file: " + dds.config);
+  }
+  read(r, f, "sample_topic", dds.sample_topic);
+  read(r, f, "alarm_topic", dds.alarm_topic);
+  read(r, f, "status_topic", dds.status_topic);
+  read(r, f, "sample_history", dds.sample_history);
+  if (dds.sample_history < 1) r.fail(r.child(f, "sample_history"), "expected a history depth >= 1");
+}
+
+void read_transport(const YamlReader& r, const Field& root, const std::string& base_dir, DaemonConfig& c) {
+  const Field t = r.child(root, "transport");
+  if (!t.present() || t.node.IsNull()) return;
+  r.check_keys(t, {"kind", "lcm", "dds"});
+  const Field kind = r.child(t, "kind");
+  if (kind.present() && !transport::parse_kind(r.name(kind), c.transport.kind))
+    r.fail(kind, "expected lcm or dds, got \"" + r.name(kind) + "\"");
+  read_lcm(r, t, c.transport.lcm);
+  read_dds(r, t, base_dir, c.transport.dds);
+}
+
+void read_service(const YamlReader& r, const Field& root, DaemonConfig& c) {
+  read(r, root, "status_period", c.status_period);
+  if (c.status_period < 0.01 || c.status_period > 3600)
+    r.fail(r.child(root, "status_period"), "expected seconds in 0.01..3600");
+  read(r, root, "queue_capacity", c.queue_capacity);
+  if (c.queue_capacity < 2 || c.queue_capacity > (1 << 20))
+    r.fail(r.child(root, "queue_capacity"), "expected a number of samples in 2..1048576");
+  read(r, root, "log_interval", c.log_interval);
+  if (c.log_interval < 0) r.fail(r.child(root, "log_interval"), "expected seconds >= 0");
+}
+
+}  // namespace
+
+DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string& source_name,
+                                 const std::string& base_dir) {
+  const YamlReader r(source_name);
+  YAML::Node document;
+  try {
+    document = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    throw yaml_error(e, source_name, "invalid YAML");
+  }
+  const Field root = r.root(document);
+  try {
+    r.check_keys(root, {"controller_id", "plant", "monitor", "transport", "status_period", "queue_capacity",
+                        "log_interval"});
+    DaemonConfig c;
+    c.source = source_name;
+    c.controller_id = r.name(r.child(root, "controller_id"));
+    const Field plant = r.child(root, "plant");
+    c.plant_path = resolve(r.name(plant), base_dir);
+    if (!std::filesystem::exists(c.plant_path)) r.fail(plant, "no such plant file: " + c.plant_path);
+    read_monitor(r, root, c);
+    read_transport(r, root, base_dir, c);
+    read_service(r, root, c);
+    return c;
+  } catch (const YAML::Exception& e) {
+    throw yaml_error(e, source_name, "unexpected structure");
+  }
+}
+
+DaemonConfig load_daemon_config(const std::string& path) {
+  const std::string base_dir = std::filesystem::path(path).parent_path().string();
+  return parse_daemon_config(detail::read_file(path), path, base_dir);
+}
+
+}  // namespace mpm::config

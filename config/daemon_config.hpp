@@ -1,0 +1,47 @@
+// The service configuration, mpmd.yaml: which controller to watch, its plant
+// file, the monitor's settings and the transport. Every key but
+// controller_id and plant is optional; defaults are those of MonitorSettings
+// and transport::Settings. Errors name the file, line, key and what was
+// expected (ConfigError), like the plant loader's.
+//
+//   controller_id: wood-berry-1
+//   plant: wood-berry.yaml          # relative to this file's folder
+//   monitor: {ar_order: 10, input_order: 10, forgetting: 0.999, false_alarm: 1e-3,
+//             clear_ratio: 0.5, raise_after: 20, clear_after: 100, warmup: 0,
+//             gamma_lambda: 0.1, settle_samples: auto}
+//   transport:
+//     kind: lcm                     # lcm | dds
+//     lcm: {url: "udpm://239.255.76.67:7667?ttl=0", sample_channel: MPM_SAMPLE,
+//           alarm_channel: MPM_ALARM, status_channel: MPM_STATUS}
+//     dds: {domain: 0, config: cyclonedds-loopback.xml, sample_topic: mpm_sample,
+//           alarm_topic: mpm_alarm, status_topic: mpm_status, sample_history: 64}
+//   status_period: 1.0              # seconds
+//   queue_capacity: 4096            # samples between receiver and monitor
+//   log_interval: 60                # seconds between repeats of one kind of log line
+#pragma once
+
+#include <string>
+
+#include "core/granger_monitor.hpp"
+#include "transport/transport_settings.hpp"
+
+namespace mpm::config {
+
+struct DaemonConfig {
+  std::string source;          // the file it was read from
+  std::string controller_id;   // samples of other controllers are ignored
+  std::string plant_path;      // resolved against the config file's folder
+  MonitorSettings monitor;
+  int settle_samples = -1;     // samples skipped after the model starts; -1 = automatic
+  transport::Settings transport;
+  double status_period = 1.0;  // seconds between status messages
+  int queue_capacity = 4096;   // samples buffered between receiver and monitor
+  double log_interval = 60.0;  // seconds between repeats of one kind of log line
+};
+
+// `base_dir` resolves relative paths (plant, DDS config); "" = as given.
+DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string& source_name,
+                                 const std::string& base_dir);
+DaemonConfig load_daemon_config(const std::string& path);
+
+}  // namespace mpm::config

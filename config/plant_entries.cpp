@@ -1,0 +1,178 @@
+#include "config/plant_entries.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "core/transfer_function.hpp"
+
+namespace mpm::config::detail {
+namespace {
+
+std::string join(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+std::string format_number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", x);
+  return text;
+}
+
+bool all_zero(const std::vector<double>& v) {
+  return std::all_of(v.begin(), v.end(), [](double x) { return x == 0.0; });
+}
+
+std::size_t index_of(const YamlReader& reader, const Field& field,
+                     const std::vector<std::string>& names, const std::string& kind) {
+  const std::string name = reader.name(field);
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end())
+    reader.fail(field, "unknown " + kind + " \"" + name + "\" (the plant's " + kind +
+                           "s are: " + join(names) + ")");
+  return static_cast<std::size_t>(it - names.begin());
+}
+
+int read_delay(const YamlReader& reader, const Field& field) {
+  if (!field.present()) return 0;
+  const int delay = reader.integer(field);
+  if (delay < 0) reader.fail(field, "expected a delay >= 0 samples, got " + std::to_string(delay));
+  if (delay > kMaxDelaySamples)
+    reader.fail(field, "delay of " + std::to_string(delay) + " samples is beyond the limit of " +
+                           std::to_string(kMaxDelaySamples));
+  return delay;
+}
+
+// num, den (optional, default [1]) and delay (optional, default 0) of a
+// discrete entry, not yet normalised.
+DiscreteTf read_discrete(const YamlReader& reader, const Field& entry) {
+  DiscreteTf tf;
+  tf.num = reader.numbers(reader.child(entry, "num"));
+  const Field den = reader.child(entry, "den");
+  tf.den = den.present() ? reader.numbers(den) : std::vector<double>{1.0};
+  if (tf.den.front() == 0.0)
+    reader.fail(reader.element(den, 0), "den[0] must be nonzero (den is normalised to den[0] = 1)");
+  tf.delay = read_delay(reader, reader.child(entry, "delay"));
+  return tf;
+}
+
+// Leading zeros of an s-polynomial (highest power first) do not change it.
+std::vector<double> strip_leading_zeros(std::vector<double> p) {
+  const auto first = std::find_if(p.begin(), p.end(), [](double x) { return x != 0.0; });
+  if (first == p.end()) return {0.0};
+  p.erase(p.begin(), first);
+  return p;
+}
+
+ContinuousTf read_continuous(const YamlReader& reader, const Field& field, double ts) {
+  reader.check_keys(field, {"num", "den", "dead_time"});
+  const Field num = reader.child(field, "num");
+  const Field den = reader.child(field, "den");
+  ContinuousTf g;
+  g.num = strip_leading_zeros(reader.numbers(num));
+  g.den = strip_leading_zeros(reader.numbers(den));
+  if (all_zero(g.den)) reader.fail(den, "the denominator must not be zero");
+  if (!all_zero(g.num) && g.num.size() > g.den.size())
+    reader.fail(num, "improper transfer function: numerator degree " +
+                         std::to_string(g.num.size() - 1) + " is above denominator degree " +
+                         std::to_string(g.den.size() - 1) + " (a ZOH model must be proper)");
+  const Field dead = reader.child(field, "dead_time");
+  g.dead_time = dead.present() ? reader.number(dead) : 0.0;
+  if (g.dead_time < 0.0)
+    reader.fail(dead, "expected a dead time >= 0 seconds, got " + format_number(g.dead_time));
+  if (g.dead_time / ts > kMaxDelaySamples)
+    reader.fail(dead, "dead time of " + format_number(g.dead_time) + " s is more than " +
+                          std::to_string(kMaxDelaySamples) + " samples");
+  return g;
+}
+
+void fill_continuous(const YamlReader& reader, const Field& entry, double ts, ChannelModel& ch) {
+  for (const char* key : {"num", "den", "delay"}) {
+    const Field stray = reader.child(entry, key);
+    if (stray.present())
+      reader.fail(stray,
+                  "does not go with 'continuous': give num, den and dead_time inside "
+                  "continuous: {...}, or use the discrete form alone");
+  }
+  const Field field = reader.child(entry, "continuous");
+  ContinuousTf g = read_continuous(reader, field, ts);
+  ch.explicit_zero = all_zero(g.num);
+  if (!ch.explicit_zero) {
+    try {
+      ch.tf = discretize_zoh(g, ts);
+    } catch (const std::invalid_argument& e) {
+      reader.fail(field, std::string("cannot discretise: ") + e.what());
+    }
+  }
+  ch.continuous = std::move(g);
+}
+
+double largest_root(const std::vector<double>& ascending) {
+  const auto roots = root_magnitudes(ascending);
+  return roots.empty() ? 0.0 : *std::max_element(roots.begin(), roots.end());
+}
+
+// Roots this close to the unit circle count as on it (as has_integrator does).
+constexpr double kUnitCircleMargin = 1e-9;
+
+void check_noise_roots(const YamlReader& reader, const Field& entry, const DiscreteTf& tf) {
+  const double pole = largest_root(tf.den);
+  if (pole >= 1.0 - kUnitCircleMargin)
+    reader.fail(reader.child(entry, "den"), "N must be stable: it has a pole of magnitude " +
+                                                format_number(pole) +
+                                                " on or outside the unit circle");
+  const double zero = largest_root(tf.num);
+  if (zero >= 1.0 - kUnitCircleMargin)
+    reader.fail(reader.child(entry, "num"),
+                "N must have a stable inverse: it has a zero of magnitude " + format_number(zero) +
+                    " on or outside the unit circle (N is non-minimum-phase)");
+}
+
+}  // namespace
+
+ChannelModel read_channel(const YamlReader& reader, const Field& entry, const PlantModel& plant) {
+  reader.check_keys(entry, {"output", "input", "num", "den", "delay", "continuous"});
+  ChannelModel ch;
+  ch.output = index_of(reader, reader.child(entry, "output"), plant.outputs, "output");
+  ch.input = index_of(reader, reader.child(entry, "input"), plant.inputs, "input");
+  if (reader.child(entry, "continuous").present()) {
+    fill_continuous(reader, entry, plant.sample_time, ch);
+    return ch;
+  }
+  DiscreteTf tf = read_discrete(reader, entry);
+  ch.explicit_zero = all_zero(tf.num);
+  if (!ch.explicit_zero) {
+    tf.normalise();
+    ch.tf = std::move(tf);
+  }
+  return ch;
+}
+
+NoiseEntry read_noise(const YamlReader& reader, const Field& entry, const PlantModel& plant) {
+  reader.check_keys(entry, {"output", "num", "den", "delay", "variance"});
+  NoiseEntry out;
+  out.output = index_of(reader, reader.child(entry, "output"), plant.outputs, "output");
+  DiscreteTf tf = read_discrete(reader, entry);
+  if (tf.delay != 0)
+    reader.fail(reader.child(entry, "delay"),
+                "must be 0: a delayed disturbance model N has no causal inverse");
+  if (tf.num.front() == 0.0)
+    reader.fail(reader.element(reader.child(entry, "num"), 0),
+                "num[0] must be nonzero: N must be invertible (its inverse is den/num)");
+  tf.normalise();
+  check_noise_roots(reader, entry, tf);
+  out.model.tf = std::move(tf);
+  const Field variance = reader.child(entry, "variance");
+  if (variance.present()) {
+    const double v = reader.number(variance);
+    if (v <= 0.0) reader.fail(variance, "expected a variance > 0, got " + format_number(v));
+    out.model.variance = v;
+  }
+  return out;
+}
+
+}  // namespace mpm::config::detail

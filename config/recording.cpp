@@ -1,0 +1,178 @@
+// CSV recordings (formats.md section 2): parse, load, write.
+//
+// Recordings reach millions of rows, so the reader takes the whole text at
+// once, walks it with string_views (no per-line or per-field allocation) and
+// converts with std::from_chars; values go into one row-major buffer that is
+// copied into the matrix at the end.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <string_view>
+
+#include "config/file_text.hpp"
+#include "config/number_text.hpp"
+#include "config/plant_loader.hpp"
+
+namespace mpm::config {
+namespace {
+
+using detail::trim;
+
+// Hands out the lines of a text one at a time, without '\n' or a final '\r'.
+class LineCursor {
+ public:
+  explicit LineCursor(std::string_view text) : rest_(text) {}
+  bool done() const { return rest_.empty(); }
+  std::size_t number() const { return number_; }  // 1-based, of the last line returned
+  std::string_view next() {
+    const auto end = rest_.find('\n');
+    std::string_view line = rest_.substr(0, end);
+    rest_ = end == std::string_view::npos ? std::string_view{} : rest_.substr(end + 1);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    ++number_;
+    return line;
+  }
+  // True when nothing but line breaks and blanks remains (a trailing newline
+  // or a few empty lines at the end are tolerated).
+  bool only_blank_left() const {
+    return rest_.find_first_not_of(" \t\r\n") == std::string_view::npos;
+  }
+
+ private:
+  std::string_view rest_;
+  std::size_t number_ = 0;
+};
+
+std::string where(const std::string& source, std::size_t line) {
+  return source + ":" + std::to_string(line) + ": ";
+}
+
+std::size_t count_fields(std::string_view line) {
+  return static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
+}
+
+std::vector<std::string> parse_header(std::string_view line, const std::string& source) {
+  std::vector<std::string> names;
+  std::map<std::string_view, std::size_t> column_of;
+  std::size_t start = 0;
+  for (std::size_t col = 1;; ++col) {
+    const auto comma = line.find(',', start);
+    const std::string_view name = trim(line.substr(start, comma - start));
+    if (name.empty())
+      throw ConfigError(where(source, 1) + "column " + std::to_string(col) +
+                        " of the header has no name");
+    const auto [it, fresh] = column_of.emplace(name, col);
+    if (!fresh)
+      throw ConfigError(where(source, 1) + "duplicate column name '" + std::string(name) +
+                        "' (columns " + std::to_string(it->second) + " and " + std::to_string(col) +
+                        ")");
+    names.emplace_back(name);
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  return names;
+}
+
+double parse_field(std::string_view field, const std::string& source, std::size_t line,
+                   const std::string& column) {
+  field = trim(field);
+  if (field.empty() || detail::is_nan_word(field)) return std::numeric_limits<double>::quiet_NaN();
+  const auto value = detail::parse_double(field);
+  if (!value || !std::isfinite(*value))
+    throw ConfigError(where(source, line) + "column '" + column +
+                      "': expected a finite number (or an empty field or nan for a missing "
+                      "sample), got '" +
+                      std::string(field) + "'");
+  return *value;
+}
+
+// Appends one data line's values; throws on a wrong field count or a bad value.
+void parse_row(std::string_view line, std::size_t line_number,
+               const std::vector<std::string>& names, const std::string& source,
+               std::vector<double>& values) {
+  std::size_t start = 0;
+  for (std::size_t col = 0; col < names.size(); ++col) {
+    const auto comma = line.find(',', start);
+    const bool last = col + 1 == names.size();
+    if ((comma == std::string_view::npos) != last)
+      throw ConfigError(where(source, line_number) + "expected " + std::to_string(names.size()) +
+                        " fields (as in the header), got " + std::to_string(count_fields(line)));
+    values.push_back(
+        parse_field(line.substr(start, comma - start), source, line_number, names[col]));
+    start = comma + 1;
+  }
+}
+
+void append_value(std::string& out, double x, const std::string& path, std::size_t row,
+                  const std::string& column) {
+  if (std::isnan(x)) return;  // missing sample: empty field
+  if (std::isinf(x))
+    throw ConfigError(path + ": row " + std::to_string(row) + ", column '" + column +
+                      "': cannot write an infinite value (only finite numbers or NaN)");
+  char text[32];
+  // Shortest representation that reads back to the same bits.
+  const auto result = std::to_chars(text, text + sizeof text, x);
+  out.append(text, result.ptr);
+}
+
+}  // namespace
+
+std::optional<std::size_t> Recording::find(const std::string& name) const {
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) return std::nullopt;
+  return static_cast<std::size_t>(it - names.begin());
+}
+
+Recording parse_recording(const std::string& csv_text, const std::string& source_name) {
+  std::string_view text = csv_text;
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
+  LineCursor lines(text);
+  if (lines.only_blank_left())
+    throw ConfigError(source_name + ":1: empty file, expected a header line with column names");
+  Recording rec;
+  rec.source = source_name;
+  rec.names = parse_header(lines.next(), source_name);
+  const std::size_t cols = rec.names.size();
+  std::vector<double> values;
+  values.reserve(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n') + 1) * cols);
+  while (!lines.only_blank_left()) {
+    const std::string_view line = lines.next();
+    parse_row(line, lines.number(), rec.names, source_name, values);
+  }
+  const auto rows = static_cast<Eigen::Index>(values.size() / cols);
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  rec.data = Eigen::Map<const RowMajor>(values.data(), rows, static_cast<Eigen::Index>(cols));
+  return rec;
+}
+
+Recording load_recording(const std::string& path) {
+  return parse_recording(detail::read_file(path), path);
+}
+
+void write_recording(const std::string& path, const Recording& rec) {
+  if (static_cast<std::size_t>(rec.data.cols()) != rec.names.size())
+    throw ConfigError(path + ": recording has " + std::to_string(rec.names.size()) + " names but " +
+                      std::to_string(rec.data.cols()) + " data columns");
+  std::string out;
+  for (std::size_t c = 0; c < rec.names.size(); ++c) {
+    const std::string& name = rec.names[c];
+    if (name.empty() || name.find_first_of(",\"\r\n") != std::string::npos || trim(name) != name)
+      throw ConfigError(path + ": column name '" + name + "' cannot be written in a CSV header");
+    out += (c ? "," : "") + name;
+  }
+  out += '\n';
+  out.reserve(out.size() + static_cast<std::size_t>(rec.data.size()) * 20);
+  for (Eigen::Index r = 0; r < rec.data.rows(); ++r) {
+    for (Eigen::Index c = 0; c < rec.data.cols(); ++c) {
+      if (c) out += ',';
+      append_value(out, rec.data(r, c), path, static_cast<std::size_t>(r),
+                   rec.names[static_cast<std::size_t>(c)]);
+    }
+    out += '\n';
+  }
+  detail::write_file(path, out);
+}
+
+}  // namespace mpm::config

@@ -1,0 +1,115 @@
+// `mpm listen`: prints the monitors' alarms and status as JSON lines, the way
+// an operator (or a test, or jq) watches them.
+#include <signal.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+#include "daemon/args.hpp"
+#include "daemon/command.hpp"
+#include "daemon/net_cli.hpp"
+#include "transport/message_json.hpp"
+#include "transport/transport.hpp"
+
+namespace mpm {
+namespace {
+
+constexpr const char* kUsage =
+    "usage: mpm listen (--transport lcm|dds | --config mpmd.yaml) [options]\n"
+    "  Prints alarms and status messages, one JSON object per line, until interrupted.\n"
+    "options:\n"
+    "  --alarms-only         no status lines\n"
+    "  --samples             print controller samples too\n"
+    "  --controller ID       only messages of this controller\n"
+    "  --count N             exit after N lines (exit 1 if the timeout comes first)\n"
+    "  --timeout SECONDS     exit after this long (0 = never, the default)\n";
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_stop(int) { g_stop = true; }
+
+struct Filter {
+  std::string controller;
+  bool alarms_only = false;
+  long count = 0;  // 0 = unlimited
+  long printed = 0;
+
+  bool wants(const std::string& controller_id) const { return controller.empty() || controller == controller_id; }
+  void print(const std::string& line) {
+    if (count > 0 && printed >= count) return;
+    std::fputs(line.c_str(), stdout);
+    std::fputc('\n', stdout);
+    std::fflush(stdout);
+    ++printed;
+  }
+  bool done() const { return count > 0 && printed >= count; }
+};
+
+int listen(transport::Transport& t, Filter& filter, bool samples, double timeout_s) {
+  t.subscribe_alarms([&](const msg::Alarm& a) {
+    if (filter.wants(a.controller_id)) filter.print(msg::to_json(a));
+  });
+  if (!filter.alarms_only) {
+    t.subscribe_status([&](const msg::Status& s) {
+      if (filter.wants(s.controller_id)) filter.print(msg::to_json(s));
+    });
+  }
+  if (samples) {
+    t.subscribe_samples([&](const msg::Sample& s) {
+      if (filter.wants(s.controller_id)) filter.print(msg::to_json(s));
+    });
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (!g_stop && !filter.done()) {
+    if (timeout_s > 0 && std::chrono::steady_clock::now() >= deadline) break;
+    if (t.handle(std::chrono::milliseconds(100)) < 0) {
+      std::fprintf(stderr, "mpm listen: the transport failed\n");
+      return 1;
+    }
+  }
+  return filter.count > 0 && !filter.done() ? 1 : 0;
+}
+
+int run(int argc, char** argv) {
+  net_cli::NetOptions net;
+  Filter filter;
+  bool samples = false;
+  double timeout_s = 0;
+  try {
+    const Args args(argc, argv, net_cli::valued_options({"controller", "count", "timeout"}),
+                    {"alarms-only", "samples", "help"});
+    if (args.flag("help")) {
+      std::printf("%s%s", kUsage, net_cli::kOptionsHelp);
+      return 0;
+    }
+    net = net_cli::read(args);
+    filter.controller = args.get("controller").value_or("");
+    filter.alarms_only = args.flag("alarms-only");
+    filter.count = args.integer("count", 0);
+    samples = args.flag("samples");
+    timeout_s = args.number("timeout", 0);
+    if (filter.count < 0 || timeout_s < 0) throw UsageError("--count and --timeout must not be negative");
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "mpm listen: %s\n%s%s", e.what(), kUsage, net_cli::kOptionsHelp);
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mpm listen: %s\n", e.what());
+    return 1;
+  }
+  std::string error;
+  auto t = transport::create(net.transport, error);
+  if (!t) {
+    std::fprintf(stderr, "mpm listen: %s\n", error.c_str());
+    return 1;
+  }
+  signal(SIGINT, on_stop);
+  signal(SIGTERM, on_stop);
+  return listen(*t, filter, samples, timeout_s);
+}
+
+const bool registered =
+    register_command({"listen", "print the monitors' alarms and status as JSON lines (LCM or DDS)", &run});
+
+}  // namespace
+}  // namespace mpm

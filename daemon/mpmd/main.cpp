@@ -1,0 +1,147 @@
+// mpmd: watches one Model Predictive Controller for model-plant mismatch.
+//
+//   mpmd --config /etc/mpm/mpmd.yaml
+//
+// Subscribes to the controller's samples (LCM or DDS), updates the Granger
+// monitor every sample, publishes alarms when a channel's state changes and a
+// status periodically. Under systemd (Type=notify): READY=1 once serving,
+// WATCHDOG=1 while healthy, SIGHUP reloads the configuration (an invalid one
+// is logged and the running one kept), SIGTERM stops cleanly. Logs go to
+// stderr with syslog priority prefixes for journald.
+#include <signal.h>
+
+#include <atomic>
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "daemon/mpmd/log.hpp"
+#include "daemon/mpmd/notifier.hpp"
+#include "daemon/mpmd/receiver.hpp"
+#include "daemon/mpmd/sample_queue.hpp"
+#include "daemon/mpmd/service_loop.hpp"
+#include "daemon/mpmd/setup.hpp"
+#include "transport/transport.hpp"
+
+namespace {
+
+static_assert(std::atomic<bool>::is_always_lock_free, "signal handlers need lock-free flags");
+std::atomic<bool> g_stop{false};
+std::atomic<bool> g_reload{false};
+
+extern "C" void on_stop_signal(int) { g_stop = true; }
+extern "C" void on_reload_signal(int) { g_reload = true; }
+
+// Handlers only set flags; no SA_RESTART, so the main loop's poll() returns.
+void install_signal_handlers() {
+  struct sigaction stop {};
+  stop.sa_handler = on_stop_signal;
+  sigemptyset(&stop.sa_mask);
+  sigaction(SIGTERM, &stop, nullptr);
+  sigaction(SIGINT, &stop, nullptr);
+  struct sigaction reload {};
+  reload.sa_handler = on_reload_signal;
+  sigemptyset(&reload.sa_mask);
+  sigaction(SIGHUP, &reload, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+}
+
+constexpr const char* kUsage =
+    "usage: mpmd --config FILE\n"
+    "  Watches one controller for model-plant mismatch (see README: mpmd).\n"
+    "  --config FILE   service configuration (YAML)\n"
+    "  --check         load and validate the configuration, then exit\n";
+
+struct Options {
+  std::string config_path;
+  bool check_only = false;
+};
+
+// 0 = run, else the exit code.
+int parse_options(int argc, char** argv, Options& options) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      std::fputs(kUsage, stdout);
+      return -1;
+    } else if (arg == "--config" && i + 1 < argc) {
+      options.config_path = argv[++i];
+    } else if (arg.rfind("--config=", 0) == 0) {
+      options.config_path = arg.substr(9);
+    } else if (arg == "--check") {
+      options.check_only = true;
+    } else {
+      std::fprintf(stderr, "mpmd: unexpected argument '%s'\n%s", arg.c_str(), kUsage);
+      return 2;
+    }
+  }
+  if (options.config_path.empty()) {
+    std::fprintf(stderr, "mpmd: --config is required\n%s", kUsage);
+    return 2;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace mpm;
+  Options options;
+  if (const int rc = parse_options(argc, argv, options); rc != 0) return rc < 0 ? 0 : rc;
+  install_signal_handlers();
+
+  // 1. Configuration: one clear error and a non-zero exit when invalid.
+  std::string error;
+  std::optional<LoadedConfig> loaded = load_config(options.config_path, error);
+  if (!loaded) {
+    log::write(log::Level::kError, "%s", error.c_str());
+    return 1;
+  }
+
+  // 2. The monitor (its alarms go out through the transport made next).
+  std::unique_ptr<transport::Transport> transport;
+  std::unique_ptr<MonitorService> service = make_service(*loaded, publish_to(transport), error);
+  if (!service) {
+    log::write(log::Level::kError, "%s", error.c_str());
+    return 1;
+  }
+  if (options.check_only) {
+    std::printf("%s: valid (controller '%s', plant %s)\n", options.config_path.c_str(),
+                loaded->config.controller_id.c_str(), loaded->config.plant_path.c_str());
+    return 0;
+  }
+
+  // 3. Transport, the bounded queue and the receiver thread.
+  transport = transport::create(loaded->config.transport, error);
+  if (!transport) {
+    log::write(log::Level::kError, "%s", error.c_str());
+    return 1;
+  }
+  transport->advertise(transport::Transport::Topic::kAlarm);
+  transport->advertise(transport::Transport::Topic::kStatus);
+  SampleQueue queue(static_cast<std::size_t>(loaded->config.queue_capacity));
+  Receiver receiver(*transport, queue);
+  if (!receiver.start(error)) {
+    log::write(log::Level::kError, "%s", error.c_str());
+    return 1;
+  }
+
+  // 4. Serving: tell systemd.
+  const std::string serving = "watching controller '" + loaded->config.controller_id + "' on " + transport->describe();
+  Notifier notifier;
+  notifier.ready(serving);
+  log::write(log::Level::kNotice, "%s (plant %s, %zu inputs, %zu outputs, settle %d samples)", serving.c_str(),
+             loaded->config.plant_path.c_str(), loaded->plant.n_inputs(), loaded->plant.n_outputs(),
+             service->settle_samples());
+
+  // 5. Until SIGTERM / SIGINT; SIGHUP reloads.
+  ServiceLoop loop(options.config_path, std::move(*loaded), std::move(service), queue, receiver, *transport,
+                   notifier);
+  const int rc = loop.run(g_stop, g_reload);
+
+  // 6. Tear down in reverse.
+  notifier.stopping();
+  receiver.stop();
+  log::write(log::Level::kNotice, "stopped");
+  return rc;
+}

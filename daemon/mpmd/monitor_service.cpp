@@ -1,0 +1,318 @@
+#include "daemon/mpmd/monitor_service.hpp"
+
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "core/noise_filter.hpp"
+#include "daemon/mpmd/log.hpp"
+
+namespace mpm {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// The automatic settle time is the plant's 1% settling time, capped: an
+// integrating channel never settles.
+constexpr std::size_t kSettleCap = 2000;
+// A gap longer than this restarts the settle time: the model held the last
+// input through it while the plant saw the real ones, and that error decays
+// like a start-up transient. Shorter gaps leave a negligible error.
+constexpr std::int64_t kResettleGap = 5;
+// Missing samples fed through the model for one gap at most; beyond, the
+// model's time is lost anyway and the settle restart covers it.
+constexpr std::int64_t kMaxGapFill = 10000;
+
+std::vector<std::optional<std::vector<double>>> noise_ar(const PlantModel& plant, int order) {
+  std::vector<std::optional<std::vector<double>>> out(plant.n_outputs());
+  for (std::size_t j = 0; j < plant.n_outputs() && j < plant.noise.size(); ++j) {
+    if (plant.noise[j]) out[j] = inverse_noise_ar_coefficients(plant.noise[j]->tf, order);
+  }
+  return out;
+}
+
+bool all_finite(const std::vector<double>& v) noexcept {
+  for (const double x : v) {
+    if (!std::isfinite(x)) return false;
+  }
+  return true;
+}
+
+std::chrono::duration<double> seconds(double s) { return std::chrono::duration<double>(s); }
+
+// " (N more since the last report)" or "".
+struct Suppressed {
+  explicit Suppressed(const Throttle& t) {
+    if (t.suppressed() == 0) {
+      text[0] = '\0';
+    } else {
+      std::snprintf(text, sizeof text, " (%" PRIu64 " more since the last report)", t.suppressed());
+    }
+  }
+  char text[64];
+};
+
+}  // namespace
+
+MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& settings, AlarmSink on_alarm)
+    : plant_(plant),
+      settings_(settings),
+      on_alarm_(std::move(on_alarm)),
+      monitor_(plant.n_inputs(), plant.n_outputs(), settings.monitor, noise_ar(plant, settings.monitor.ar_order)),
+      residual_(plant.n_outputs(), 0.0),
+      nan_u_(plant.n_inputs(), kNaN),
+      nan_y_(plant.n_outputs(), kNaN),
+      alarm_state_(plant.n_inputs() * plant.n_outputs(), 0) {
+  settle_ = settings.settle_samples >= 0 ? settings.settle_samples
+                                         : static_cast<int>(settling_samples(plant, 0.01, kSettleCap));
+  settling_ = settle_;
+  if (plant.operating_point) residuals_.emplace(plant, plant.operating_point->inputs);
+  const auto interval = seconds(settings.log_interval);
+  for (Throttle* t : {&throttles_.foreign, &throttles_.gap, &throttles_.duplicate, &throttles_.out_of_order,
+                      &throttles_.restart, &throttles_.malformed, &throttles_.nan, &throttles_.dropped,
+                      &throttles_.receive_errors}) {
+    t->set_interval(interval);
+  }
+}
+
+void MonitorService::on_sample(const msg::Sample& s, Clock::time_point now) {
+  if (s.controller_id != settings_.controller_id) {
+    ++counters_.foreign;
+    if (throttles_.foreign.event(now)) {
+      log::write(log::Level::kInfo, "ignoring samples of controller '%s' (this monitor watches '%s')%s",
+                 s.controller_id.c_str(), settings_.controller_id.c_str(), Suppressed(throttles_.foreign).text);
+    }
+    return;
+  }
+  ++counters_.seen;
+  const SequenceTracker::Result r = tracker_.observe(s.session_id, s.seq);
+  report_sequence(r, s, now);
+  switch (r.verdict) {
+    case SequenceTracker::Verdict::kDuplicate:
+    case SequenceTracker::Verdict::kOutOfOrder:
+      return;
+    case SequenceTracker::Verdict::kGap:
+      skip_missing(r.missing);
+      break;
+    case SequenceTracker::Verdict::kRestart:
+      skip_missing(kResettleGap + 1);  // unknown gap: break the lags, settle again
+      break;
+    default:
+      break;
+  }
+  if (!sized_right(s)) {
+    report_malformed(s, now);
+    skip_missing(1);
+    return;
+  }
+  if (!all_finite(s.u) || !all_finite(s.y) || !all_finite(s.sim_y)) {
+    ++counters_.nan_samples;
+    if (throttles_.nan.event(now)) {
+      log::write(log::Level::kWarning,
+                 "controller '%s': sample %" PRId64 " carries NaN or infinite values: treated as missing "
+                 "(%" PRIu64 " such samples so far)%s",
+                 s.controller_id.c_str(), s.seq, counters_.nan_samples, Suppressed(throttles_.nan).text);
+    }
+  }
+  step(s.u.data(), s.y.data(), s.sim_y.empty() ? nullptr : s.sim_y.data());
+  check_alarms(s);
+}
+
+bool MonitorService::sized_right(const msg::Sample& s) const noexcept {
+  return s.u.size() == plant_.n_inputs() && s.y.size() == plant_.n_outputs() &&
+         (s.sim_y.empty() || s.sim_y.size() == plant_.n_outputs());
+}
+
+void MonitorService::skip_missing(std::int64_t count) noexcept {
+  const std::int64_t fill = count < kMaxGapFill ? count : kMaxGapFill;
+  for (std::int64_t k = 0; k < fill; ++k) step(nan_u_.data(), nan_y_.data(), nullptr);
+  if (count > kResettleGap) settling_ = settle_;
+}
+
+// Residual of one sample (NaN where values are missing), then the monitor.
+void MonitorService::step(const double* u, const double* y, const double* sim_y) noexcept {
+  if (!residuals_) {
+    bool complete = true;
+    for (std::size_t i = 0; i < plant_.n_inputs(); ++i) complete = complete && std::isfinite(u[i]);
+    if (!complete) return;  // no operating point yet: wait for a complete input sample
+    // formats.md: without an operating point, the first complete input sample
+    // is u0. Happens once per service (setup allocation, not per sample).
+    residuals_.emplace(plant_, std::vector<double>(u, u + plant_.n_inputs()));
+  }
+  residuals_->step(u, y, residual_.data());
+  if (sim_y != nullptr) {
+    for (std::size_t j = 0; j < plant_.n_outputs(); ++j) residual_[j] = y[j] - sim_y[j];
+  }
+  if (settling_ > 0) {
+    --settling_;
+    return;
+  }
+  monitor_.update(u, residual_.data());
+}
+
+void MonitorService::check_alarms(const msg::Sample& s) {
+  const std::size_t n_in = plant_.n_inputs();
+  for (std::size_t j = 0; j < plant_.n_outputs(); ++j) {
+    for (std::size_t i = 0; i < n_in; ++i) {
+      const std::uint8_t now = monitor_.channel(j, i).alarm ? 1 : 0;
+      if (now == alarm_state_[j * n_in + i]) continue;
+      alarm_state_[j * n_in + i] = now;
+      publish_alarm(j, i, s);
+    }
+  }
+}
+
+void MonitorService::publish_alarm(std::size_t output, std::size_t input, const msg::Sample& s) {
+  const ChannelStats& c = monitor_.channel(output, input);
+  alarm_.controller_id = settings_.controller_id;
+  alarm_.utime = s.utime;
+  alarm_.sample_sequence = s.seq;
+  alarm_.output = plant_.outputs[output];
+  alarm_.input = plant_.inputs[input];
+  alarm_.output_index = static_cast<std::int32_t>(output);
+  alarm_.input_index = static_cast<std::int32_t>(input);
+  alarm_.raised = c.alarm;
+  alarm_.f = c.f_conditional;
+  alarm_.p_value = monitor_.p_value(c.lr_conditional);
+  alarm_.gamma = c.gamma;
+  alarm_.physics.clear();  // the online monitor locates; naming physics is the offline diagnosis' job
+  char text[256];
+  if (c.alarm) {
+    std::snprintf(text, sizeof text,
+                  "model-plant mismatch on %s -> %s: F=%.4g, LR %.1f > %.1f (p=%.2g), gamma=%.3g",
+                  alarm_.input.c_str(), alarm_.output.c_str(), c.f_conditional, c.lr_conditional,
+                  monitor_.raise_threshold(), alarm_.p_value, c.gamma);
+  } else {
+    std::snprintf(text, sizeof text, "cleared: %s -> %s agrees with the model again: F=%.4g, LR %.1f < %.1f",
+                  alarm_.input.c_str(), alarm_.output.c_str(), c.f_conditional, c.lr_conditional,
+                  monitor_.clear_threshold());
+  }
+  alarm_.text = text;
+  log::write(c.alarm ? log::Level::kWarning : log::Level::kNotice, "controller '%s': %s (sample %" PRId64 ")",
+             settings_.controller_id.c_str(), text, s.seq);
+  if (on_alarm_) on_alarm_(alarm_);
+}
+
+void MonitorService::report_sequence(const SequenceTracker::Result& r, const msg::Sample& s,
+                                     Clock::time_point now) {
+  using V = SequenceTracker::Verdict;
+  const char* id = s.controller_id.c_str();
+  switch (r.verdict) {
+    case V::kGap:
+      ++counters_.gaps;
+      counters_.missing += static_cast<std::uint64_t>(r.missing);
+      if (throttles_.gap.event(now)) {
+        log::write(log::Level::kWarning,
+                   "controller '%s': %" PRId64 " samples missing before sample %" PRId64
+                   " (gaps so far: %" PRIu64 ")%s",
+                   id, r.missing, s.seq, counters_.gaps, Suppressed(throttles_.gap).text);
+      }
+      break;
+    case V::kDuplicate:
+      ++counters_.duplicates;
+      if (throttles_.duplicate.event(now)) {
+        log::write(log::Level::kWarning, "controller '%s': duplicate of sample %" PRId64 " ignored%s", id, s.seq,
+                   Suppressed(throttles_.duplicate).text);
+      }
+      break;
+    case V::kOutOfOrder:
+      ++counters_.out_of_order;
+      if (throttles_.out_of_order.event(now)) {
+        log::write(log::Level::kWarning,
+                   "controller '%s': sample %" PRId64 " arrived after sample %" PRId64 ": ignored%s", id, s.seq,
+                   tracker_.last(), Suppressed(throttles_.out_of_order).text);
+      }
+      break;
+    case V::kRestart:
+      ++counters_.restarts;
+      if (throttles_.restart.event(now)) {
+        log::write(log::Level::kNotice,
+                   "controller '%s': publisher restarted (session %" PRId64 ", sample %" PRId64
+                   "); statistics kept%s",
+                   id, s.session_id, s.seq, Suppressed(throttles_.restart).text);
+      }
+      break;
+    default:
+      break;
+  }
+}
+
+void MonitorService::report_malformed(const msg::Sample& s, Clock::time_point now) {
+  ++counters_.malformed;
+  if (!throttles_.malformed.event(now)) return;
+  log::write(log::Level::kWarning,
+             "controller '%s': sample %" PRId64 " has %zu inputs, %zu outputs, %zu simulated outputs; "
+             "the plant has %zu inputs and %zu outputs: ignored (malformed so far: %" PRIu64 ")%s",
+             s.controller_id.c_str(), s.seq, s.u.size(), s.y.size(), s.sim_y.size(), plant_.n_inputs(),
+             plant_.n_outputs(), counters_.malformed, Suppressed(throttles_.malformed).text);
+}
+
+void MonitorService::add_dropped(std::uint64_t count, Clock::time_point now) {
+  if (count == 0) return;
+  counters_.dropped += count;
+  if (throttles_.dropped.event(now)) {
+    log::write(log::Level::kWarning,
+               "receive queue full: %" PRIu64 " samples dropped so far (the monitor falls behind)%s",
+               counters_.dropped, Suppressed(throttles_.dropped).text);
+  }
+}
+
+void MonitorService::add_receive_errors(std::uint64_t count, Clock::time_point now) {
+  if (count == 0) return;
+  counters_.malformed += count;
+  if (throttles_.receive_errors.event(now)) {
+    log::write(log::Level::kWarning, "%" PRIu64 " messages could not be decoded (wrong type or bytes)%s", count,
+               Suppressed(throttles_.receive_errors).text);
+  }
+}
+
+void MonitorService::fill_status(msg::Status& out, std::int64_t utime, std::int64_t uptime_ms) const {
+  const MonitorCounters& mc = monitor_.counters();
+  out.controller_id = settings_.controller_id;
+  out.utime = utime;
+  out.uptime_ms = uptime_ms;
+  out.ready = monitor_.ready();
+  out.effective_samples = monitor_.effective_samples();
+  out.raise_threshold = monitor_.raise_threshold();
+  out.clear_threshold = monitor_.clear_threshold();
+  out.samples_seen = static_cast<std::int64_t>(counters_.seen);
+  out.samples_used = static_cast<std::int64_t>(mc.used);
+  out.dropped = static_cast<std::int64_t>(counters_.dropped);
+  out.gaps = static_cast<std::int64_t>(counters_.gaps);
+  out.missing = static_cast<std::int64_t>(counters_.missing);
+  out.duplicates = static_cast<std::int64_t>(counters_.duplicates);
+  out.out_of_order = static_cast<std::int64_t>(counters_.out_of_order);
+  out.restarts = static_cast<std::int64_t>(counters_.restarts);
+  out.malformed = static_cast<std::int64_t>(counters_.malformed);
+  out.nan_samples = static_cast<std::int64_t>(counters_.nan_samples);
+  const std::size_t n_in = plant_.n_inputs();
+  out.channels.resize(n_in * plant_.n_outputs());
+  out.loops.resize(plant_.n_outputs());
+  std::int64_t raised = 0;
+  for (std::size_t j = 0; j < plant_.n_outputs(); ++j) {
+    for (std::size_t i = 0; i < n_in; ++i) {
+      const ChannelStats& c = monitor_.channel(j, i);
+      msg::ChannelStatus& o = out.channels[j * n_in + i];
+      o.output = plant_.outputs[j];
+      o.input = plant_.inputs[i];
+      o.f_pairwise = c.f_pairwise;
+      o.f_conditional = c.f_conditional;
+      o.lr = c.lr_conditional;
+      o.p_value = monitor_.p_value(c.lr_conditional);
+      o.gamma = c.gamma;
+      o.alarm = c.alarm;
+      raised += c.alarm ? 1 : 0;
+    }
+    const LoopStats& l = monitor_.loop(j);
+    msg::LoopStatus& lo = out.loops[j];
+    lo.output = plant_.outputs[j];
+    lo.residual_variance = l.residual_variance;
+    lo.sigma1 = l.sigma1;
+    lo.sigma_full = l.sigma_full;
+    lo.alarm = l.alarm;
+    lo.diverging = l.diverging;
+  }
+  out.alarms_raised = raised;
+}
+
+}  // namespace mpm

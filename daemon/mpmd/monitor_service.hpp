@@ -1,0 +1,112 @@
+// The monitoring service of one controller, without any transport: samples in
+// (plain messages), alarms out (a callback), status on request. It owns the
+// core monitor by value (as PX4's bus wrapper owns its estimator), the
+// residual generator of the nominal model, the sequence tracking and the
+// data-quality counters. Unit tests drive it directly or through the fake
+// transport; mpmd wires it to LCM or DDS.
+//
+// Per sample (on_sample): controller filter -> sequence check (duplicates and
+// out-of-order samples dropped, gaps filled with missing samples so the
+// model's time stays aligned) -> size check (a wrong-sized sample counts as
+// malformed and as a missing sample) -> residual (y - sim_y when the sample
+// carries the controller's prediction, else y - G_M (u - u0)) -> monitor
+// update -> alarm edges. Every anomaly is counted for the status and logged
+// through a Throttle (first at once, then at most once per log interval).
+//
+// Allocation: setup allocates; on_sample allocates nothing in steady state.
+// Building an alarm message (rare: on a change) may grow its strings.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/granger_monitor.hpp"
+#include "core/mimo_model.hpp"
+#include "core/plant_model.hpp"
+#include "daemon/mpmd/sequence_tracker.hpp"
+#include "daemon/mpmd/throttle.hpp"
+#include "transport/messages.hpp"
+
+namespace mpm {
+
+struct ServiceSettings {
+  std::string controller_id;
+  MonitorSettings monitor;
+  // Samples skipped after the nominal model starts (or restarts after a long
+  // gap) while its start-up transient decays; -1 = the plant's settling time.
+  int settle_samples = -1;
+  double log_interval = 60.0;  // seconds between repeats of one kind of log line
+};
+
+struct ServiceCounters {
+  std::uint64_t seen = 0;          // samples of this controller
+  std::uint64_t gaps = 0;          // sequence gaps
+  std::uint64_t missing = 0;       // samples lost in them
+  std::uint64_t duplicates = 0;
+  std::uint64_t out_of_order = 0;
+  std::uint64_t restarts = 0;
+  std::uint64_t malformed = 0;     // wrong sizes, plus bytes the transport could not decode
+  std::uint64_t nan_samples = 0;
+  std::uint64_t dropped = 0;       // lost before the service (receive queue full)
+  std::uint64_t foreign = 0;       // samples of other controllers, ignored
+};
+
+class MonitorService {
+ public:
+  using AlarmSink = std::function<void(const msg::Alarm&)>;
+  using Clock = Throttle::Clock;
+
+  // Setup: allocates everything. Throws std::invalid_argument when the
+  // settings are invalid for this plant.
+  MonitorService(const PlantModel& plant, const ServiceSettings& settings, AlarmSink on_alarm);
+
+  // One received sample (any controller). See the overview for the steps.
+  void on_sample(const msg::Sample& sample, Clock::time_point now);
+
+  // Samples lost before they reached the service, and messages the transport
+  // could not decode: counted and logged (throttled).
+  void add_dropped(std::uint64_t count, Clock::time_point now);
+  void add_receive_errors(std::uint64_t count, Clock::time_point now);
+
+  // Current statistics and counters. Reuses `out`'s storage.
+  void fill_status(msg::Status& out, std::int64_t utime, std::int64_t uptime_ms) const;
+
+  const ServiceCounters& counters() const noexcept { return counters_; }
+  const GrangerMonitor& monitor() const noexcept { return monitor_; }
+  const PlantModel& plant() const noexcept { return plant_; }
+  const ServiceSettings& settings() const noexcept { return settings_; }
+  int settle_samples() const noexcept { return settle_; }
+  const AlarmSink& alarm_sink() const noexcept { return on_alarm_; }
+
+ private:
+  bool sized_right(const msg::Sample& s) const noexcept;
+  void skip_missing(std::int64_t count) noexcept;
+  void step(const double* u, const double* y, const double* sim_y) noexcept;
+  void check_alarms(const msg::Sample& s);
+  void publish_alarm(std::size_t output, std::size_t input, const msg::Sample& s);
+  void report_sequence(const SequenceTracker::Result& r, const msg::Sample& s, Clock::time_point now);
+  void report_malformed(const msg::Sample& s, Clock::time_point now);
+
+  PlantModel plant_;
+  ServiceSettings settings_;
+  AlarmSink on_alarm_;
+  GrangerMonitor monitor_;
+  std::optional<ResidualGenerator> residuals_;  // made at the first complete input sample
+  SequenceTracker tracker_;
+  ServiceCounters counters_;
+  int settle_ = 0;       // samples to skip after a (re)start of the model
+  int settling_ = 0;     // of those, still to skip
+  std::vector<double> residual_;
+  std::vector<double> nan_u_, nan_y_;        // a missing sample
+  std::vector<std::uint8_t> alarm_state_;    // output-major, as published
+  msg::Alarm alarm_;
+
+  struct Throttles {
+    Throttle foreign, gap, duplicate, out_of_order, restart, malformed, nan, dropped, receive_errors;
+  } throttles_;
+};
+
+}  // namespace mpm

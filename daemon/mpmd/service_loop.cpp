@@ -1,0 +1,147 @@
+#include "daemon/mpmd/service_loop.hpp"
+
+#include <poll.h>
+
+#include <algorithm>
+#include <cinttypes>
+
+#include "daemon/mpmd/log.hpp"
+
+namespace mpm {
+namespace {
+
+// Samples handled between two looks at the clock: bounds how late a status
+// or a watchdog ping can be while samples pour in.
+constexpr int kDrainBatch = 4096;
+// Longest sleep: flags set by a signal that arrived between two polls are
+// seen at least this often.
+constexpr std::chrono::milliseconds kMaxWait{200};
+
+std::int64_t unix_micros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::chrono::steady_clock::duration period(double seconds) {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+}
+
+}  // namespace
+
+ServiceLoop::ServiceLoop(std::string config_path, LoadedConfig running, std::unique_ptr<MonitorService> service,
+                         SampleQueue& queue, Receiver& receiver, transport::Transport& transport,
+                         Notifier& notifier)
+    : config_path_(std::move(config_path)),
+      running_(std::move(running)),
+      service_(std::move(service)),
+      queue_(queue),
+      receiver_(receiver),
+      transport_(transport),
+      notifier_(notifier) {}
+
+int ServiceLoop::run(const std::atomic<bool>& stop, std::atomic<bool>& reload) {
+  started_ = Clock::now();
+  next_status_ = started_;  // a first status at once: listeners see the monitor is up
+  next_watchdog_ = started_;
+  while (!stop.load()) {
+    if (reload.exchange(false)) apply_reload();
+    if (receiver_.failed()) {
+      log::write(log::Level::kError, "the transport failed: exiting");
+      return 1;
+    }
+    drain(Clock::now());
+    const auto now = Clock::now();
+    account_losses(now);
+    if (now >= next_status_) publish_status(now);
+    feed_watchdog(now);
+    if (queue_.size() > 0) continue;  // more than a batch waiting
+    auto until = std::min(next_status_, now + kMaxWait);
+    if (notifier_.watchdog_period()) until = std::min(until, next_watchdog_);
+    wait(until);
+  }
+  publish_status(Clock::now());  // the final counts
+  return 0;
+}
+
+void ServiceLoop::drain(Clock::time_point now) {
+  receiver_.clear_wake();
+  for (int n = 0; n < kDrainBatch; ++n) {
+    const msg::Sample* sample = queue_.front();
+    if (sample == nullptr) return;
+    service_->on_sample(*sample, now);
+    queue_.pop();
+  }
+}
+
+void ServiceLoop::account_losses(Clock::time_point now) {
+  const std::uint64_t dropped = receiver_.dropped();
+  service_->add_dropped(dropped - dropped_seen_, now);
+  dropped_seen_ = dropped;
+  const std::uint64_t errors = transport_.receive_errors();
+  service_->add_receive_errors(errors - receive_errors_seen_, now);
+  receive_errors_seen_ = errors;
+}
+
+void ServiceLoop::publish_status(Clock::time_point now) {
+  const auto uptime = std::chrono::duration_cast<std::chrono::milliseconds>(now - started_).count();
+  service_->fill_status(status_, unix_micros(), uptime);
+  if (!transport_.publish(status_) && status_failures_++ == 0) {
+    log::write(log::Level::kError, "could not publish the status on %s", transport_.describe().c_str());
+  }
+  next_status_ = now + period(running_.config.status_period);
+}
+
+// Ping only while the receiver thread keeps coming back from the transport:
+// a wedged receiver then lets systemd's watchdog restart the service.
+void ServiceLoop::feed_watchdog(Clock::time_point now) {
+  const auto wd = notifier_.watchdog_period();
+  if (!wd || now < next_watchdog_) return;
+  if (now - receiver_.last_alive() < *wd) notifier_.watchdog();
+  next_watchdog_ = now + *wd;
+}
+
+void ServiceLoop::apply_reload() {
+  notifier_.reloading();
+  std::string error;
+  auto next = load_config(config_path_, error);
+  if (!next) {
+    log::write(log::Level::kError, "reload failed, keeping the running configuration: %s", error.c_str());
+    notifier_.ready("reload failed; running the previous configuration");
+    return;
+  }
+  const auto& was = running_.config.transport;
+  const auto& now = next->config.transport;
+  if (was.kind != now.kind || was.lcm.url != now.lcm.url || was.lcm.sample_channel != now.lcm.sample_channel ||
+      was.lcm.alarm_channel != now.lcm.alarm_channel || was.lcm.status_channel != now.lcm.status_channel ||
+      was.dds.domain != now.dds.domain || was.dds.config != now.dds.config ||
+      was.dds.sample_topic != now.dds.sample_topic || was.dds.alarm_topic != now.dds.alarm_topic ||
+      was.dds.status_topic != now.dds.status_topic || running_.config.queue_capacity != next->config.queue_capacity) {
+    log::write(log::Level::kWarning, "transport and queue settings take effect at the next restart");
+  }
+  if (next->monitor_fingerprint != running_.monitor_fingerprint) {
+    auto service = make_service(*next, service_->alarm_sink(), error);
+    if (!service) {
+      log::write(log::Level::kError, "reload failed, keeping the running configuration: %s", error.c_str());
+      notifier_.ready("reload failed; running the previous configuration");
+      return;
+    }
+    service_ = std::move(service);
+    log::write(log::Level::kNotice, "reloaded %s: new monitor settings, statistics start again",
+               config_path_.c_str());
+  } else {
+    log::write(log::Level::kNotice, "reloaded %s: monitor unchanged, statistics kept", config_path_.c_str());
+  }
+  running_ = std::move(*next);
+  notifier_.ready("reloaded");
+}
+
+void ServiceLoop::wait(Clock::time_point until) {
+  const auto now = Clock::now();
+  if (until <= now) return;
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(until - now).count() + 1;
+  pollfd p{receiver_.wake_fd(), POLLIN, 0};
+  ::poll(&p, 1, static_cast<int>(ms));  // EINTR (a signal) just ends the wait early
+}
+
+}  // namespace mpm

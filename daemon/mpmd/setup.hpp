@@ -1,0 +1,37 @@
+// The set-up steps of mpmd, each a small function so that main() reads as
+// the sequence it is: configuration -> monitor -> transport -> ready.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "config/daemon_config.hpp"
+#include "core/plant_model.hpp"
+#include "daemon/mpmd/monitor_service.hpp"
+#include "transport/transport.hpp"
+
+namespace mpm {
+
+struct LoadedConfig {
+  config::DaemonConfig config;
+  PlantModel plant;
+  // What the monitor depends on (controller, plant file text, settings): a
+  // reload that leaves it unchanged keeps the running statistics.
+  std::string monitor_fingerprint;
+};
+
+// Reads mpmd.yaml and its plant file. On failure returns nothing and sets
+// `error` to one complete message (file, line, key, what was expected).
+std::optional<LoadedConfig> load_config(const std::string& path, std::string& error);
+
+// The monitoring service for a loaded configuration; nullptr and `error`
+// when the settings do not fit the plant.
+std::unique_ptr<MonitorService> make_service(const LoadedConfig& loaded, MonitorService::AlarmSink on_alarm,
+                                             std::string& error);
+
+// An alarm sink that publishes through `*transport` (once it is set) and
+// logs a failure to publish.
+MonitorService::AlarmSink publish_to(const std::unique_ptr<transport::Transport>& transport);
+
+}  // namespace mpm

@@ -1,0 +1,59 @@
+// Transport options shared by the `mpm` commands that speak LCM or DDS
+// (cmd_*_net.cpp). Either --config names an mpmd.yaml (its transport,
+// controller id and plant are used), or the options say it all; options
+// override the file.
+#pragma once
+
+#include <optional>
+#include <set>
+#include <string>
+
+#include "config/daemon_config.hpp"
+#include "daemon/args.hpp"
+#include "transport/transport_settings.hpp"
+
+namespace mpm::net_cli {
+
+constexpr const char* kOptionsHelp =
+    "transport options:\n"
+    "  --config FILE        take transport, controller id and plant from an mpmd.yaml\n"
+    "  --transport lcm|dds  which transport (required without --config)\n"
+    "  --lcm-url URL        LCM URL (default udpm://239.255.76.67:7667?ttl=0)\n"
+    "  --dds-domain N       DDS domain id (default 0)\n"
+    "  --dds-config FILE    Cyclone DDS XML configuration (default: $CYCLONEDDS_URI)\n"
+    "  --sample-channel C, --alarm-channel C, --status-channel C   LCM channels / DDS topics\n";
+
+inline std::set<std::string> valued_options(std::set<std::string> more) {
+  more.insert({"config", "transport", "lcm-url", "dds-domain", "dds-config", "sample-channel", "alarm-channel",
+               "status-channel"});
+  return more;
+}
+
+struct NetOptions {
+  transport::Settings transport;
+  std::optional<config::DaemonConfig> daemon;  // when --config was given
+};
+
+// Throws UsageError for a bad option, config::ConfigError for a bad file.
+inline NetOptions read(const Args& args) {
+  NetOptions o;
+  if (auto path = args.get("config")) {
+    o.daemon = config::load_daemon_config(*path);
+    o.transport = o.daemon->transport;
+  } else if (!args.get("transport")) {
+    throw UsageError("--transport lcm|dds (or --config FILE) is required");
+  }
+  if (auto kind = args.get("transport"); kind && !transport::parse_kind(*kind, o.transport.kind)) {
+    throw UsageError("--transport: expected lcm or dds, got '" + *kind + "'");
+  }
+  if (auto url = args.get("lcm-url")) o.transport.lcm.url = *url;
+  o.transport.dds.domain = args.integer("dds-domain", o.transport.dds.domain);
+  if (o.transport.dds.domain < 0 || o.transport.dds.domain > 230) throw UsageError("--dds-domain: expected 0..230");
+  if (auto file = args.get("dds-config")) o.transport.dds.config = *file;
+  if (auto c = args.get("sample-channel")) o.transport.lcm.sample_channel = o.transport.dds.sample_topic = *c;
+  if (auto c = args.get("alarm-channel")) o.transport.lcm.alarm_channel = o.transport.dds.alarm_topic = *c;
+  if (auto c = args.get("status-channel")) o.transport.lcm.status_channel = o.transport.dds.status_topic = *c;
+  return o;
+}
+
+}  // namespace mpm::net_cli
