@@ -46,7 +46,8 @@ std::string MonitorSettings::validate() const {
 
 GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, const MonitorSettings& settings,
                                std::vector<std::optional<std::vector<double>>> n_inverse_ar,
-                               std::vector<double> reference_variance)
+                               std::vector<double> reference_variance,
+                               const std::vector<std::optional<DiscreteTf>>& channel_models)
     : settings_(settings), n_inputs_(n_inputs), n_outputs_(n_outputs) {
   if (const std::string err = settings.validate(); !err.empty()) throw std::invalid_argument(err);
   if (n_inputs == 0 || n_outputs == 0) throw std::invalid_argument("monitor needs at least one input and one output");
@@ -56,10 +57,32 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   nb_ = static_cast<std::size_t>(settings.input_order);
   const std::size_t p_full = n_regressors();
   const std::size_t p_pair = 1 + na_ + nb_;
+  input_lags_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nb_), static_cast<Eigen::Index>(n_outputs * n_inputs));
+  channel_filters_.resize(n_outputs * n_inputs);
+  if (!channel_models.empty() && channel_models.size() != n_outputs * n_inputs)
+    throw std::invalid_argument("channel models: need n_outputs * n_inputs entries");
+  for (std::size_t c = 0; c < channel_models.size(); ++c) {
+    if (!channel_models[c] || channel_models[c]->is_zero()) continue;
+    DiscreteTf tf = *channel_models[c];
+    tf.normalise();
+    std::size_t lead = 0;  // leading zero coefficients are delay
+    while (lead + 1 < tf.num.size() && tf.num[lead] == 0.0) ++lead;
+    tf.num.erase(tf.num.begin(), tf.num.begin() + static_cast<long>(lead));
+    tf.delay += static_cast<int>(lead);
+    if (tf.delay > 0) --tf.delay;  // stepping with u(k) gives G u at k+1
+    if (!tf.is_stable()) continue;  // an integrating model channel would drift: plain lags
+    channel_filters_[c].emplace(tf);
+    // The filter starts at rest after a (re)start: wait for its memory too.
+    double slowest = 0.0;
+    for (double mag : root_magnitudes(tf.den)) slowest = std::max(slowest, mag);
+    int settle = tf.delay + static_cast<int>(tf.num.size());
+    if (slowest > 0.0) settle += static_cast<int>(std::ceil(std::log(0.01) / std::log(slowest)));
+    filter_settle_ = std::max(filter_settle_, std::min(settle, 2000));
+  }
   // After a start or a gap, the residual lags need na samples; the Laguerre
   // states need nb samples and then until the pre-gap memory (zeroed) has
-  // decayed to 1 %.
-  lags_needed_ = static_cast<int>(std::max(na_, nb_));
+  // decayed to 1 %; model filters likewise.
+  lags_needed_ = static_cast<int>(std::max(na_, nb_)) + filter_settle_;
   if (settings.input_pole > 0.0)
     lags_needed_ = std::max(lags_needed_, static_cast<int>(nb_) + static_cast<int>(std::ceil(std::log(0.01) / std::log(settings.input_pole))));
   warmup_ = settings.warmup > 0 ? settings.warmup : static_cast<int>(10 * p_full);
@@ -67,7 +90,6 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   full_.assign(n_outputs, SqrtRls(p_full, settings.forgetting, kRegularization));
   pairwise_.assign(n_outputs * n_inputs, SqrtRls(p_pair, settings.forgetting, kRegularization));
   residual_lags_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(na_), static_cast<Eigen::Index>(n_outputs));
-  input_lags_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nb_), static_cast<Eigen::Index>(n_inputs));
   input_ref_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_inputs));
   row_.resize(static_cast<Eigen::Index>(p_full));
   pair_row_.resize(static_cast<Eigen::Index>(p_pair));
@@ -97,6 +119,8 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   const double dof = static_cast<double>(nb_);
   lr_raise_ = chi_square_quantile_upper(settings.false_alarm, dof);
   lr_clear_ = settings.clear_ratio * lr_raise_;
+  lr_joint_raise_ = chi_square_quantile_upper(settings.false_alarm, dof * static_cast<double>(n_inputs));
+  lr_joint_clear_ = settings.clear_ratio * lr_joint_raise_;
   reset();
 }
 
@@ -105,6 +129,8 @@ void GrangerMonitor::reset() noexcept {
   for (auto& r : pairwise_) r.reset();
   residual_lags_.setZero();
   input_lags_.setZero();
+  for (auto& f : channel_filters_)
+    if (f) f->reset(0.0);
   lags_filled_ = 0;
   in_gap_ = false;
   sum_w_ = sum_w2_ = n_eq_ = 0.0;
@@ -123,6 +149,10 @@ double GrangerMonitor::p_value(double lr) const noexcept {
   return chi_square_survival(lr, static_cast<double>(nb_));
 }
 
+double GrangerMonitor::joint_p_value(double lr) const noexcept {
+  return chi_square_survival(lr, static_cast<double>(nb_ * n_inputs_));
+}
+
 SampleStatus GrangerMonitor::update(const double* u, const double* residual) noexcept {
   ++counters_.samples;
   if (!finite_all(u, n_inputs_) || !finite_all(residual, n_outputs_)) {
@@ -133,6 +163,8 @@ SampleStatus GrangerMonitor::update(const double* u, const double* residual) noe
     in_gap_ = true;
     lags_filled_ = 0;
     input_lags_.setZero();
+    for (auto& f : channel_filters_)
+      if (f) f->reset(0.0);
     return SampleStatus::kMissing;
   }
   in_gap_ = false;
@@ -162,16 +194,18 @@ void GrangerMonitor::absorb_sample(const double* residual) noexcept {
   const auto na = static_cast<Eigen::Index>(na_);
   const auto nb = static_cast<Eigen::Index>(nb_);
   row_[0] = 1.0;
-  for (std::size_t i = 0; i < n_inputs_; ++i)
-    row_.segment(1 + na + static_cast<Eigen::Index>(i) * nb, nb) = input_lags_.col(static_cast<Eigen::Index>(i));
   pair_row_[0] = 1.0;
   for (std::size_t j = 0; j < n_outputs_; ++j) {
     const auto jj = static_cast<Eigen::Index>(j);
+    const auto first_channel = static_cast<Eigen::Index>(j * n_inputs_);
+    for (std::size_t i = 0; i < n_inputs_; ++i)
+      row_.segment(1 + na + static_cast<Eigen::Index>(i) * nb, nb) =
+          input_lags_.col(first_channel + static_cast<Eigen::Index>(i));
     row_.segment(1, na) = residual_lags_.col(jj);
     full_[j].update(row_.data(), residual[j]);
     pair_row_.segment(1, na) = residual_lags_.col(jj);
     for (std::size_t i = 0; i < n_inputs_; ++i) {
-      pair_row_.segment(1 + na, nb) = input_lags_.col(static_cast<Eigen::Index>(i));
+      pair_row_.segment(1 + na, nb) = input_lags_.col(first_channel + static_cast<Eigen::Index>(i));
       pairwise_[j * n_inputs_ + i].update(pair_row_.data(), residual[j]);
     }
   }
@@ -186,10 +220,13 @@ void GrangerMonitor::push_lags(const double* u, const double* residual) noexcept
   // x_r <- a x_r + x_{r-1}(old) - a x_{r-1}(new). With a = 0: a shift register.
   const double a = settings_.input_pole;
   const double gain = std::sqrt(1.0 - a * a);
-  for (std::size_t i = 0; i < n_inputs_; ++i) {
-    double* x = input_lags_.col(static_cast<Eigen::Index>(i)).data();
+  for (std::size_t c = 0; c < n_outputs_ * n_inputs_; ++c) {
+    const std::size_t i = c % n_inputs_;
+    double source = u[i] - input_ref_[static_cast<Eigen::Index>(i)];
+    if (channel_filters_[c]) source = channel_filters_[c]->step(source);
+    double* x = input_lags_.col(static_cast<Eigen::Index>(c)).data();
     double prev_old = x[0];
-    x[0] = a * x[0] + gain * (u[i] - input_ref_[static_cast<Eigen::Index>(i)]);
+    x[0] = a * x[0] + gain * source;
     for (std::size_t r = 1; r < nb_; ++r) {
       const double old = x[r];
       x[r] = a * x[r] + prev_old - a * x[r - 1];
@@ -202,6 +239,9 @@ void GrangerMonitor::push_lags(const double* u, const double* residual) noexcept
 void GrangerMonitor::update_divergence(const double* residual) noexcept {
   for (std::size_t j = 0; j < n_outputs_; ++j) {
     const auto jj = static_cast<Eigen::Index>(j);
+    // Residuals carry the outputs' operating-point offset: start the running
+    // mean there, not at zero.
+    if (used_since_reset_ == 1) mean_fast_[jj] = residual[j];
     const double dev = residual[j] - mean_fast_[jj];
     mean_fast_[jj] += (1.0 - kFastMemory) * dev;
     var_fast_[jj] = kFastMemory * var_fast_[jj] + (1.0 - kFastMemory) * dev * dev;
@@ -227,7 +267,8 @@ void GrangerMonitor::update_statistics() noexcept {
     loop.sigma1 = full.rss_prefix(1 + na_) / sum_w_;
     loop.sigma_full = rss_full / sum_w_;
     loop.residual_variance = full.rss_prefix(1) / sum_w_;
-    bool any_alarm = false;
+    loop.lr_joint = scale_full * std::log(full.rss_prefix(1 + na_) / rss_full);
+    bool any_channel = false;
     for (std::size_t i = 0; i < n_inputs_; ++i) {
       ChannelStats& c = channels_[j * n_inputs_ + i];
       const double rss_without = full.rss_without(1 + na_ + i * nb_, nb_, scratch_);
@@ -248,27 +289,42 @@ void GrangerMonitor::update_statistics() noexcept {
         const double dist = (pair_coef_.segment(1, static_cast<Eigen::Index>(na_)) - g_n).squaredNorm();
         c.gamma = dist / (1.0 + g_n.squaredNorm());
       }
-      if (testing) update_alarm(c);
+      if (testing) update_hysteresis(c, c.lr_conditional, lr_raise_, lr_clear_, c.alarm);
       if (loop.diverging) c.alarm = false;  // no verdict on a diverging loop
-      any_alarm = any_alarm || c.alarm;
+      any_channel = any_channel || c.alarm;
     }
-    loop.alarm = any_alarm;
+    if (testing) update_hysteresis(loop, loop.lr_joint, lr_joint_raise_, lr_joint_clear_, loop.joint_alarm);
+    if (loop.diverging) loop.joint_alarm = false;
+    loop.alarm = loop.joint_alarm || any_channel;
+    // Paper Sec. 3.3: with the loop raised but no input standing out on its
+    // own, the channel whose AR part matches N^-1 (gamma < lambda^2, the
+    // smallest) carries the mismatch.
+    std::size_t best = n_inputs_;
+    const double limit = settings_.gamma_lambda * settings_.gamma_lambda;
+    for (std::size_t i = 0; i < n_inputs_; ++i) {
+      ChannelStats& c = channels_[j * n_inputs_ + i];
+      c.located_by_gamma = false;
+      if (loop.alarm && !any_channel && c.gamma < limit && (best == n_inputs_ || c.gamma < channels_[j * n_inputs_ + best].gamma))
+        best = i;
+    }
+    if (best < n_inputs_) channels_[j * n_inputs_ + best].located_by_gamma = true;
   }
 }
 
-void GrangerMonitor::update_alarm(ChannelStats& c) noexcept {
-  if (c.lr_conditional > lr_raise_) {
-    ++c.above;
-    c.below = 0;
-  } else if (c.lr_conditional < lr_clear_) {
-    ++c.below;
-    c.above = 0;
+template <typename Stats>
+void GrangerMonitor::update_hysteresis(Stats& s, double lr, double raise, double clear, bool& alarm) noexcept {
+  if (lr > raise) {
+    ++s.above;
+    s.below = 0;
+  } else if (lr < clear) {
+    ++s.below;
+    s.above = 0;
   } else {  // in the hysteresis band: neither counter advances
-    c.above = 0;
-    c.below = 0;
+    s.above = 0;
+    s.below = 0;
   }
-  if (!c.alarm && c.above >= settings_.raise_after) c.alarm = true;
-  if (c.alarm && c.below >= settings_.clear_after) c.alarm = false;
+  if (!alarm && s.above >= settings_.raise_after) alarm = true;
+  if (alarm && s.below >= settings_.clear_after) alarm = false;
 }
 
 void GrangerMonitor::full_coefficients(std::size_t output, Eigen::Ref<Eigen::VectorXd> out) const noexcept {

@@ -18,12 +18,26 @@
 //   * the paper's pairwise index F(u_i -> d~_j) = ln(Sigma1 / Sigma2),
 //   * the AR coefficients the paper compares with N^-1: gamma(u_i -> d~_j).
 //
+// Model-filtered regressors (optional): given the nominal channel G_ji, the
+// regressors of input i in output j's models are lags of G_ji u_i instead of
+// u_i. Still the past of u_i (G_ji is strictly causal), but a gain mismatch
+// dG = (k - 1) G_ji then lies in the span of two regressors instead of being
+// smeared over nb lags and the residual's own AR part, so the test has far
+// more power on the slow, closed-loop data MPCs produce. Channels the model
+// says are zero keep plain lags (a missing channel has no shape to borrow).
+//
 // Tests: each index becomes a likelihood-ratio statistic LR = n_eq * F,
 // chi-square with nb degrees of freedom under "no causality", where n_eq =
 // (sum w)^2 / sum w^2 is the equivalent sample count of the forgetting
 // weights (= n for lambda = 1). The alarm threshold is precomputed at setup
 // from the per-channel false-alarm probability, so the hot path compares
 // numbers; p-values are computed on request (publishing, reports).
+//
+// Loops: the joint test of all inputs together (AR-only vs full model,
+// m*nb dof) raises the loop; it keeps its power when closed-loop inputs are
+// nearly collinear and no single input's conditional test can tell them
+// apart. Then the paper's noise-model index names the channel
+// (located_by_gamma).
 //
 // Alarms: a channel is raised when its conditional LR exceeds the threshold
 // for `raise_after` consecutive samples, cleared when it stays below the
@@ -39,6 +53,7 @@
 #include <Eigen/Dense>
 
 #include "core/sqrt_rls.hpp"
+#include "core/transfer_function.hpp"
 
 namespace mpm {
 
@@ -76,16 +91,23 @@ struct ChannelStats {
   double lr_pairwise = 0.0;    // n_eq * f_pairwise
   double lr_conditional = 0.0; // n_eq * f_conditional
   double gamma = 0.0;          // noise-model index (NaN when N is unknown)
-  bool alarm = false;
+  bool alarm = false;          // raised by its own conditional test
+  bool located_by_gamma = false;  // the loop is raised, no input passes its
+                               // own test, and this channel's gamma < lambda^2
+                               // is the smallest: the paper's locating rule
   int above = 0;               // consecutive samples above the raise level
   int below = 0;               // consecutive samples below the clear level
 };
 
 struct LoopStats {
+  double lr_joint = 0.0;         // all inputs together vs AR only, m*nb dof
+  bool joint_alarm = false;      // the joint test's own alarm state
+  int above = 0;                 // hysteresis counters of the joint test
+  int below = 0;
   double sigma1 = 0.0;           // AR-only residual variance (weighted)
   double sigma_full = 0.0;       // full-model residual variance (weighted)
   double residual_variance = 0.0;// weighted variance of d~ about its mean
-  bool alarm = false;            // any channel of this output raised
+  bool alarm = false;            // joint test raised, or any channel raised
   bool diverging = false;        // residual variance growing without bound
 };
 
@@ -104,9 +126,13 @@ class GrangerMonitor {
   // given and > 0, is the variance the residual of output j has with a
   // matched model (N's output variance): a residual far above it means the
   // loop diverges. Throws std::invalid_argument on invalid settings or sizes.
+  // `channel_models`, when given, has n_outputs * n_inputs entries (output
+  // major): the nominal G_ji for model-filtered regressors, nullopt or a zero
+  // channel for plain lags.
   GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, const MonitorSettings& settings,
                  std::vector<std::optional<std::vector<double>>> n_inverse_ar = {},
-                 std::vector<double> reference_variance = {});
+                 std::vector<double> reference_variance = {},
+                 const std::vector<std::optional<DiscreteTf>>& channel_models = {});
 
   // Real-time safe: no allocation, no exceptions. u: n_inputs values at time
   // k, residual: n_outputs values of d~ at time k. Returns what was done.
@@ -122,6 +148,9 @@ class GrangerMonitor {
   // Equivalent sample count behind the current statistics.
   double effective_samples() const noexcept { return n_eq_; }
   double raise_threshold() const noexcept { return lr_raise_; }
+  double joint_raise_threshold() const noexcept { return lr_joint_raise_; }
+  // p-value of a loop's joint LR (chi-square, n_inputs * nb dof).
+  double joint_p_value(double lr) const noexcept;
   double clear_threshold() const noexcept { return lr_clear_; }
   bool ready() const noexcept;  // warm-up over
 
@@ -148,7 +177,8 @@ class GrangerMonitor {
   void absorb_sample(const double* residual) noexcept;
   void push_lags(const double* u, const double* residual) noexcept;
   void update_statistics() noexcept;
-  void update_alarm(ChannelStats& c) noexcept;
+  template <typename Stats>
+  void update_hysteresis(Stats& s, double lr, double raise, double clear, bool& alarm) noexcept;
   void update_divergence(const double* residual) noexcept;
 
   MonitorSettings settings_;
@@ -159,10 +189,15 @@ class GrangerMonitor {
   int warmup_;
 
   // Residual lags per output, newest first (na_ each), shifted each sample;
-  // Laguerre states per input (nb_ each), regressors for the next sample.
+  // input regressor states per (output, input) channel (nb_ each, output
+  // major): the basis applied to u_i or to G_ji u_i, for the next sample.
   Eigen::MatrixXd residual_lags_;  // na_ x n_outputs
-  Eigen::MatrixXd input_lags_;     // nb_ x n_inputs
+  Eigen::MatrixXd input_lags_;     // nb_ x (n_outputs * n_inputs)
+  // Per channel: q G_ji (one sample of the delay removed, so stepping it with
+  // u(k) yields G_ji u at k+1), or empty for plain lags.
+  std::vector<std::optional<DiscreteFilter>> channel_filters_;
   int lags_filled_ = 0;            // valid consecutive samples in the lags
+  int filter_settle_ = 0;          // samples for the model filters to settle
   int lags_needed_ = 0;            // samples to fill lags / settle the basis
   Eigen::VectorXd input_ref_;      // input level at (re)start: the basis sees
                                    // u - input_ref_, so its zero state is at rest
@@ -187,6 +222,8 @@ class GrangerMonitor {
   double n_eq_ = 0.0;
   double lr_raise_ = 0.0;
   double lr_clear_ = 0.0;
+  double lr_joint_raise_ = 0.0;
+  double lr_joint_clear_ = 0.0;
   // Divergence detection per output: running mean and variance of d~ with a
   // short memory, and the quietest variance seen (the baseline).
   Eigen::VectorXd mean_fast_;

@@ -27,7 +27,7 @@ constexpr const char* kUsage =
     "  --timeout SECONDS     exit after this long (0 = never, the default)\n";
 
 std::atomic<bool> g_stop{false};
-extern "C" void on_stop(int) { g_stop = true; }
+void on_stop(int) { g_stop = true; }
 
 struct Filter {
   std::string controller;

@@ -28,6 +28,8 @@ constexpr const char* kUsage =
     "                     needs records much longer than nb/(1-A) samples to stay calibrated)\n"
     "  --forgetting L     RLS forgetting factor in (0.9, 1] (default 1: the whole record)\n"
     "  --false-alarm A    per-channel test level alpha (default 1e-3)\n"
+    "  --plain-lags       regress on plain input lags as in the paper (default: lags of the\n"
+    "                     input filtered through the nominal channel G_ji, where it is nonzero)\n"
     "  --json             print one JSON object instead of the table\n";
 
 struct ChannelTrace {
@@ -46,15 +48,15 @@ void print_table(const PlantModel& plant, const GrangerMonitor& m, const std::ve
               m.effective_samples());
   for (std::size_t j = 0; j < m.n_outputs(); ++j) {
     const LoopStats& l = m.loop(j);
-    std::printf("\noutput %s: %s   residual variance %.4g, AR-only Sigma1 %.4g, full model %.4g\n",
+    std::printf("\noutput %s: %s   joint p %.3g, residual variance %.4g, AR-only Sigma1 %.4g, full model %.4g\n",
                 plant.outputs[j].c_str(), l.diverging ? "DIVERGING (not analysed)" : l.alarm ? "MISMATCH" : "ok",
-                l.residual_variance, l.sigma1, l.sigma_full);
+                m.joint_p_value(l.lr_joint), l.residual_variance, l.sigma1, l.sigma_full);
     std::printf("  %-10s %12s %12s %12s %10s  %s\n", "input", "F pairwise", "F cond.", "p (cond.)", "gamma", "alarm");
     for (std::size_t i = 0; i < m.n_inputs(); ++i) {
       const ChannelStats& c = m.channel(j, i);
       const ChannelTrace& t = trace[j * m.n_inputs() + i];
       std::printf("  %-10s %12.4g %12.4g %12.3g %10.4g  %s", plant.inputs[i].c_str(), c.f_pairwise, c.f_conditional,
-                  m.p_value(c.lr_conditional), c.gamma, c.alarm ? "RAISED" : "-");
+                  m.p_value(c.lr_conditional), c.gamma, c.alarm ? "RAISED" : c.located_by_gamma ? "located by gamma" : "-");
       if (t.raised_at >= 0) std::printf(" (first raised at sample %ld)", t.raised_at);
       std::printf("\n");
     }
@@ -74,9 +76,9 @@ void print_json(const PlantModel& plant, const GrangerMonitor& m, const std::vec
     for (std::size_t i = 0; i < m.n_inputs(); ++i) {
       const ChannelStats& c = m.channel(j, i);
       std::printf("%s{\"input\": \"%s\", \"F\": %.6g, \"F_conditional\": %.6g, \"p_value\": %.6g, \"gamma\": %s, "
-                  "\"alarm\": %s, \"raised_at\": %ld}",
+                  "\"alarm\": %s, \"located_by_gamma\": %s, \"raised_at\": %ld}",
                   i ? ", " : "", plant.inputs[i].c_str(), c.f_pairwise, c.f_conditional, m.p_value(c.lr_conditional),
-                  std::isfinite(c.gamma) ? std::to_string(c.gamma).c_str() : "null", c.alarm ? "true" : "false",
+                  std::isfinite(c.gamma) ? std::to_string(c.gamma).c_str() : "null", c.alarm ? "true" : "false", c.located_by_gamma ? "true" : "false",
                   trace[j * m.n_inputs() + i].raised_at);
     }
     std::printf("]}");
@@ -87,7 +89,7 @@ void print_json(const PlantModel& plant, const GrangerMonitor& m, const std::vec
 int run(int argc, char** argv) {
   try {
     const Args args(argc, argv, {"plant", "data", "ar-order", "input-order", "input-pole", "forgetting", "false-alarm"},
-                    {"json", "help"});
+                    {"json", "plain-lags", "help"});
     if (args.flag("help")) {
       std::fputs(kUsage, stdout);
       return 0;
@@ -106,7 +108,8 @@ int run(int argc, char** argv) {
     const config::BoundRecording bound = config::bind(plant, rec);
     const ResidualSeries series = compute_residuals(plant, rec, bound);
 
-    GrangerMonitor monitor(plant.n_inputs(), plant.n_outputs(), settings, noise_ar(plant, settings.ar_order), reference_variances(plant));
+    GrangerMonitor monitor(plant.n_inputs(), plant.n_outputs(), settings, noise_ar(plant, settings.ar_order), reference_variances(plant),
+                           args.flag("plain-lags") ? std::vector<std::optional<DiscreteTf>>{} : channel_models(plant));
     std::vector<ChannelTrace> trace(plant.n_inputs() * plant.n_outputs());
     run_monitor(monitor, series, [&](std::size_t k, const GrangerMonitor& m) {
       for (std::size_t j = 0; j < m.n_outputs(); ++j)

@@ -37,11 +37,13 @@ void print_case(const PaperCase& pc, const PaperCaseResult& r) {
   }
   std::printf("   mpm located  : %s\n", channel_list(r.plant, r.located).c_str());
   for (std::size_t j = 0; j < m.n_outputs(); ++j) {
-    std::printf("     %-7s", r.plant.outputs[j].c_str());
+    std::printf("     %-7s joint p=%.1e%s", r.plant.outputs[j].c_str(), m.joint_p_value(m.loop(j).lr_joint),
+                m.loop(j).lr_joint > m.joint_raise_threshold() ? "*" : " ");
     for (std::size_t i = 0; i < m.n_inputs(); ++i) {
       const ChannelStats& c = m.channel(j, i);
       std::printf("  %s: F=%.4f p=%.1e g=%.4f%s", r.plant.inputs[i].c_str(), c.f_pairwise,
-                  m.p_value(c.lr_conditional), c.gamma, c.alarm ? "*" : "");
+                  m.p_value(c.lr_conditional), c.gamma,
+                  c.lr_conditional > m.raise_threshold() ? "*" : r.by_gamma[j * m.n_inputs() + i] ? "(g)" : "");
     }
     std::printf("\n");
   }
@@ -69,7 +71,7 @@ int run(int argc, char** argv) {
     MonitorSettings settings;  // paper-sized orders; whole record (lambda = 1)
     settings.forgetting = 1.0;
     std::printf("mpm paper: online monitor na=%d nb=%d, conditional LR test at alpha=%g per channel "
-                "(* = alarm); F = paper's pairwise index, g = gamma (noise-model index)\n",
+                "(* = significant, (g) = located by gamma); F = paper's pairwise index, g = gamma (noise-model index)\n",
                 settings.ar_order, settings.input_order, settings.false_alarm);
     int ours = 0, theirs = 0, n = 0;
     for (const PaperCase& pc : paper_cases()) {

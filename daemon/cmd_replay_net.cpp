@@ -32,7 +32,7 @@ constexpr const char* kUsage =
     "  --wait-readers SECONDS DDS: wait this long for a subscriber before publishing (default 10)\n";
 
 std::atomic<bool> g_stop{false};
-extern "C" void on_stop(int) { g_stop = true; }
+void on_stop(int) { g_stop = true; }
 
 struct ReplayOptions {
   std::string data;

@@ -56,6 +56,43 @@ std::vector<std::optional<std::vector<double>>> noise_ar(const PlantModel& plant
   return out;
 }
 
+RecordVerdict record_verdict(const GrangerMonitor& m) {
+  RecordVerdict v;
+  v.loop_mismatch.assign(m.n_outputs(), false);
+  v.by_gamma.assign(m.n_outputs() * m.n_inputs(), false);
+  const double limit = m.settings().gamma_lambda * m.settings().gamma_lambda;
+  for (std::size_t j = 0; j < m.n_outputs(); ++j) {
+    if (m.loop(j).diverging) {
+      v.diverging = true;
+      continue;
+    }
+    bool any = false;
+    for (std::size_t i = 0; i < m.n_inputs(); ++i)
+      if (m.channel(j, i).lr_conditional > m.raise_threshold()) {
+        v.located.emplace_back(j, i);
+        any = true;
+      }
+    if (!any && m.loop(j).lr_joint > m.joint_raise_threshold()) {
+      std::size_t best = m.n_inputs();
+      for (std::size_t i = 0; i < m.n_inputs(); ++i)
+        if (m.channel(j, i).gamma < limit && (best == m.n_inputs() || m.channel(j, i).gamma < m.channel(j, best).gamma))
+          best = i;
+      if (best < m.n_inputs()) {
+        v.located.emplace_back(j, best);
+        v.by_gamma[j * m.n_inputs() + best] = true;
+      }
+    }
+    v.loop_mismatch[j] = any || m.loop(j).lr_joint > m.joint_raise_threshold();
+  }
+  return v;
+}
+
+std::vector<std::optional<DiscreteTf>> channel_models(const PlantModel& plant) {
+  std::vector<std::optional<DiscreteTf>> out(plant.n_outputs() * plant.n_inputs());
+  for (const auto& c : plant.channels) out[c.output * plant.n_inputs() + c.input] = c.tf;
+  return out;
+}
+
 std::vector<double> reference_variances(const PlantModel& plant) {
   std::vector<double> out(plant.n_outputs(), 0.0);
   for (std::size_t j = 0; j < plant.n_outputs() && j < plant.noise.size(); ++j)

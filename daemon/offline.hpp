@@ -34,6 +34,24 @@ std::vector<std::optional<std::vector<double>>> noise_ar(const PlantModel& plant
 // variance), 0 where the plant file gives no noise model or no variance.
 std::vector<double> reference_variances(const PlantModel& plant);
 
+// The nominal channels G_ji, output major, for the monitor's model-filtered
+// regressors (nullopt where the model has no channel).
+std::vector<std::optional<DiscreteTf>> channel_models(const PlantModel& plant);
+
+// The verdict on a whole record, from the statistics after its last sample
+// (with forgetting 1 they summarise the whole record; the alarm state with
+// its hysteresis is for live use): a channel is located when its own
+// conditional test rejects at the monitor's alpha; in a loop where none does
+// but the joint test of all inputs rejects, the paper's gamma rule names the
+// channel (gamma < lambda^2, the smallest). Diverging loops locate nothing.
+struct RecordVerdict {
+  std::vector<std::pair<std::size_t, std::size_t>> located;  // (output, input), row major
+  std::vector<bool> loop_mismatch;                           // per output
+  std::vector<bool> by_gamma;                                // per channel, output major
+  bool diverging = false;
+};
+RecordVerdict record_verdict(const GrangerMonitor& monitor);
+
 // Runs the online monitor over the series (after the transient), calling
 // `on_sample(k, monitor)` after each update when given.
 template <typename OnSample>

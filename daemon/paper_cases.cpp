@@ -21,7 +21,7 @@ const std::vector<PaperCase>& paper_cases() {
        "F: loop 1 u1 0.0722, u2 0.0403; loop 2 u1 0.0249, u2 0.0069; gamma(u2->d1) = 0.0060, "
        "gamma(u1->d2) = 0.0039 locate G12 and G21; decussation CAID (0.1074, -0.1074), MQI (0.1178, 0.8297): "
        "mislocates",
-       {{1, 0}, {0, 1}},
+       {{0, 1}, {1, 0}},
        false},
       {"quad-tank-g23-order",
        "loop 2: F = 2.5e-4, 0.0040, 9.5e-4, 0.0012; gamma(u3->d2) = 0.0026 < 0.01 locates G23", {{1, 2}}, false},
@@ -45,14 +45,14 @@ PaperCaseResult run_paper_case(const std::string& scenario, std::uint64_t seed, 
   const config::BoundRecording bound = config::bind(plant, rec);
   const ResidualSeries series = compute_residuals(plant, rec, bound);
   PaperCaseResult out{plant, GrangerMonitor(plant.n_inputs(), plant.n_outputs(), settings,
-                                            noise_ar(plant, settings.ar_order), reference_variances(plant)),
-                      {}, {}, false, rec.samples()};
+                                            noise_ar(plant, settings.ar_order), reference_variances(plant),
+                                            channel_models(plant)),
+                      {}, {}, {}, false, rec.samples()};
   run_monitor(out.monitor, series, [](std::size_t, const GrangerMonitor&) {});
-  for (std::size_t j = 0; j < plant.n_outputs(); ++j) {
-    out.diverging = out.diverging || out.monitor.loop(j).diverging;
-    for (std::size_t i = 0; i < plant.n_inputs(); ++i)
-      if (out.monitor.channel(j, i).alarm) out.located.emplace_back(j, i);
-  }
+  const RecordVerdict verdict = record_verdict(out.monitor);
+  out.located = verdict.located;
+  out.by_gamma = verdict.by_gamma;
+  out.diverging = verdict.diverging;
   // The baseline sees the same residual (transient skipped), where it can.
   std::vector<DiscreteTf> noise;
   for (const auto& n : plant.noise) noise.push_back(n ? n->tf : DiscreteTf{{1.0}, {1.0}, 0});

@@ -30,7 +30,8 @@ struct PaperCaseResult {
   PlantModel plant;
   GrangerMonitor monitor;
   DecussationResult decussation;
-  std::vector<Channel> located;  // channels alarmed at the end of the record
+  std::vector<Channel> located;  // record_verdict(): located over the whole record
+  std::vector<bool> by_gamma;    // per channel (output major): located by the gamma rule
   bool diverging = false;        // some loop diverged: no verdict
   std::size_t samples = 0;
 };
