@@ -297,14 +297,15 @@ void GrangerMonitor::update_statistics() noexcept {
     if (loop.diverging) loop.joint_alarm = false;
     loop.alarm = loop.joint_alarm || any_channel;
     // Paper Sec. 3.3: with the loop raised but no input standing out on its
-    // own, the channel whose AR part matches N^-1 (gamma < lambda^2, the
-    // smallest) carries the mismatch.
+    // own, among the channels whose AR part matches N^-1 (gamma < lambda^2)
+    // the one with the largest pairwise F carries the mismatch.
     std::size_t best = n_inputs_;
     const double limit = settings_.gamma_lambda * settings_.gamma_lambda;
     for (std::size_t i = 0; i < n_inputs_; ++i) {
       ChannelStats& c = channels_[j * n_inputs_ + i];
       c.located_by_gamma = false;
-      if (loop.alarm && !any_channel && c.gamma < limit && (best == n_inputs_ || c.gamma < channels_[j * n_inputs_ + best].gamma))
+      if (loop.alarm && !any_channel && c.gamma < limit &&
+          (best == n_inputs_ || c.f_pairwise > channels_[j * n_inputs_ + best].f_pairwise))
         best = i;
     }
     if (best < n_inputs_) channels_[j * n_inputs_ + best].located_by_gamma = true;

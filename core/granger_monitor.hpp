@@ -36,8 +36,8 @@
 // Loops: the joint test of all inputs together (AR-only vs full model,
 // m*nb dof) raises the loop; it keeps its power when closed-loop inputs are
 // nearly collinear and no single input's conditional test can tell them
-// apart. Then the paper's noise-model index names the channel
-// (located_by_gamma).
+// apart. Then the paper's two indices name the channel (located_by_gamma):
+// of the channels whose AR part matches N^-1, the one with the largest F.
 //
 // Alarms: a channel is raised when its conditional LR exceeds the threshold
 // for `raise_after` consecutive samples, cleared when it stays below the
@@ -93,8 +93,9 @@ struct ChannelStats {
   double gamma = 0.0;          // noise-model index (NaN when N is unknown)
   bool alarm = false;          // raised by its own conditional test
   bool located_by_gamma = false;  // the loop is raised, no input passes its
-                               // own test, and this channel's gamma < lambda^2
-                               // is the smallest: the paper's locating rule
+                               // own test, this channel's gamma < lambda^2 and
+                               // its pairwise F is the largest of those: the
+                               // paper's locating rule
   int above = 0;               // consecutive samples above the raise level
   int below = 0;               // consecutive samples below the clear level
 };

@@ -75,7 +75,8 @@ RecordVerdict record_verdict(const GrangerMonitor& m) {
     if (!any && m.loop(j).lr_joint > m.joint_raise_threshold()) {
       std::size_t best = m.n_inputs();
       for (std::size_t i = 0; i < m.n_inputs(); ++i)
-        if (m.channel(j, i).gamma < limit && (best == m.n_inputs() || m.channel(j, i).gamma < m.channel(j, best).gamma))
+        if (m.channel(j, i).gamma < limit &&
+            (best == m.n_inputs() || m.channel(j, i).f_pairwise > m.channel(j, best).f_pairwise))
           best = i;
       if (best < m.n_inputs()) {
         v.located.emplace_back(j, best);

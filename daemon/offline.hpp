@@ -42,8 +42,9 @@ std::vector<std::optional<DiscreteTf>> channel_models(const PlantModel& plant);
 // (with forgetting 1 they summarise the whole record; the alarm state with
 // its hysteresis is for live use): a channel is located when its own
 // conditional test rejects at the monitor's alpha; in a loop where none does
-// but the joint test of all inputs rejects, the paper's gamma rule names the
-// channel (gamma < lambda^2, the smallest). Diverging loops locate nothing.
+// but the joint test of all inputs rejects, the paper's two indices name the
+// channel: among those whose AR part matches N^-1 (gamma < lambda^2), the
+// one with the largest pairwise F. Diverging loops locate nothing.
 struct RecordVerdict {
   std::vector<std::pair<std::size_t, std::size_t>> located;  // (output, input), row major
   std::vector<bool> loop_mismatch;                           // per output
