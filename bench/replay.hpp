@@ -1,0 +1,21 @@
+// Offline replay throughput: a recording of the Wood-Berry column (2x2, the
+// paper's first case study) pushed through ResidualGenerator + GrangerMonitor
+// as `mpm monitor` and mpmd do per sample.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace mpm::bench {
+
+struct ReplayResult {
+  double samples_per_s = 0.0;
+  std::size_t samples = 0;
+  std::int64_t allocations = 0;  // during the timed replay (must be 0)
+};
+
+// Generates `samples` samples in memory (random inputs through the plant,
+// AR noise through N), then times the replay of all of them.
+ReplayResult measure_replay(std::size_t samples);
+
+}  // namespace mpm::bench

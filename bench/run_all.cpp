@@ -1,0 +1,170 @@
+// The measurement plan of `mpm bench`: which figures, in which order, with how
+// many repetitions (full run well under 2 minutes, --quick a smoke test).
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "bench/alloc_hook.hpp"
+#include "bench/batch_baseline.hpp"
+#include "bench/cpu_clock.hpp"
+#include "bench/figures.hpp"
+#include "bench/flops.hpp"
+#include "bench/lcm_latency.hpp"
+#include "bench/memory.hpp"
+#include "bench/replay.hpp"
+#include "bench/update_timing.hpp"
+#include "bench/workload.hpp"
+
+namespace mpm::bench {
+namespace {
+
+struct Size {
+  std::size_t n;           // n inputs x n outputs
+  std::size_t per_repeat;  // timed updates per repeat
+  std::size_t repeats;
+};
+
+std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, format, a, b, c);
+  return buf;
+}
+
+std::string tag(std::size_t n) { return std::to_string(n) + "x" + std::to_string(n); }
+
+class Plan {
+ public:
+  explicit Plan(const BenchOptions& o) : o_(o) {}
+  void say(const std::string& what) const {
+    if (o_.progress) o_.progress(what);
+  }
+  void add(std::string name, std::optional<double> value, std::string unit, std::string note) {
+    figures.push_back({std::move(name), value, std::move(unit), std::move(note)});
+  }
+  bool quick() const { return o_.quick; }
+  std::vector<Figure> figures;
+
+ private:
+  const BenchOptions& o_;
+};
+
+// First, while this process is still small: the forked child inherits it.
+void memory_figures(Plan& plan) {
+  for (std::size_t n : {std::size_t{2}, std::size_t{50}}) {
+    plan.say("resident memory of a process holding a " + tag(n) + " monitor");
+    std::string why;
+    const auto m = measure_monitor_memory(n, n, why);
+    const std::string name = "mpmd_rss_mb_" + tag(n);
+    if (!m) {
+      plan.add(name, std::nullopt, "MB", why);
+      continue;
+    }
+    plan.add(name, m->rss_mb, "MB",
+             fmt("proxy: VmRSS of a forked bench process holding the monitor after updates "
+                 "(process before it: %.1f MB; VmHWM %.1f MB)",
+                 m->baseline_mb, m->hwm_mb));
+  }
+}
+
+void update_figures(Plan& plan, const PeakRate& peak, std::int64_t& allocations, std::size_t& updates) {
+  const std::vector<Size> sizes = plan.quick()
+      ? std::vector<Size>{{2, 300, 3}, {4, 50, 3}, {20, 2, 1}, {50, 1, 1}}
+      : std::vector<Size>{{2, 3000, 7}, {4, 500, 7}, {20, 4, 5}, {50, 1, 3}};
+  const MonitorSettings s = paper_settings();
+  for (const Size& size : sizes) {
+    plan.say("GrangerMonitor::update at " + tag(size.n));
+    const UpdateTiming t = time_updates(size.n, size.n, size.per_repeat, size.repeats);
+    allocations += t.allocations;
+    updates += t.updates;
+    plan.add("update_ns_" + tag(size.n), t.ns_per_update, "ns",
+             fmt("thread CPU time, median of %.0f repeats of %.0f updates (fastest %.0f ns); na=20 nb=10 lambda=0.999, all statistics "
+                 "and gamma",
+                 static_cast<double>(size.repeats), static_cast<double>(size.per_repeat), t.ns_min));
+    const MonitorFlops f = monitor_flops(size.n, size.n, static_cast<std::size_t>(s.ar_order),
+                                         static_cast<std::size_t>(s.input_order), s.forgetting < 1.0);
+    plan.add("flops_per_update_" + tag(size.n), f.total(), "flop",
+             fmt("analytic; %.0f%% conditional RSS (rss_without), %.0f%% full-model RLS, %.0f%% pairwise RLS",
+                 100.0 * f.conditional / f.total(), 100.0 * f.full_updates / f.total(),
+                 100.0 * f.pairwise_updates / f.total()));
+    const double rate = f.total() / (t.ns_per_update * 1e-9);
+    plan.add("peak_fraction_" + tag(size.n), rate / peak.flops_per_s, "",
+             fmt("%.2f GFLOP/s achieved / %.1f GFLOP/s measured single-core peak", rate * 1e-9,
+                 peak.flops_per_s * 1e-9));
+  }
+}
+
+void batch_figures(Plan& plan) {
+  plan.say("sliding-window batch QR at 2x2 (window 2000)");
+  const MonitorSettings s = paper_settings();
+  constexpr std::size_t kWindow = 2000;
+  const Workload w = make_workload(2, 2, kWindow + 600, 3);
+  SlidingWindowBatch batch(w, s.ar_order, s.input_order, kWindow);
+  const std::size_t n = plan.quick() ? 3 : 20;
+  volatile double sink = batch.update(0);  // first call sizes the QR storage
+  const double start = thread_cpu_seconds();
+  for (std::size_t k = 1; k <= n; ++k) sink = sink + batch.update(k);
+  const double ns = (thread_cpu_seconds() - start) * 1e9 / static_cast<double>(n);
+  plan.add("batch_ns_2x2", ns, "ns",
+           fmt("Householder QR of [X y] over the last 2000 samples, %.0f fits per sample (full, without each "
+               "input, AR-only, pairwise), thread CPU time, mean of %.0f samples",
+               static_cast<double>(batch.fits_per_update()), static_cast<double>(n)));
+  double update_ns = 0.0;
+  for (const Figure& f : plan.figures)
+    if (f.name == "update_ns_2x2" && f.value) update_ns = *f.value;
+  plan.add("batch_ratio_2x2", update_ns > 0.0 ? std::optional<double>(ns / update_ns) : std::nullopt, "x",
+           "batch_ns_2x2 / update_ns_2x2, same run");
+}
+
+void replay_figure(Plan& plan, std::int64_t& allocations, std::size_t& updates) {
+  const std::size_t samples = plan.quick() ? 20000 : 1000000;
+  plan.say("offline replay of " + std::to_string(samples) + " Wood-Berry samples");
+  const ReplayResult r = measure_replay(samples);
+  allocations += r.allocations;
+  updates += r.samples;
+  plan.add("replay_samples_per_s_2x2", r.samples_per_s, "samples/s",
+           fmt("%.0f-sample recording in memory (Wood-Berry, built-in plant) through ResidualGenerator + "
+               "GrangerMonitor (na=20 nb=10 lambda=0.999, gamma on), thread CPU time",
+               static_cast<double>(samples)));
+}
+
+void lcm_figures(Plan& plan) {
+  const std::size_t messages = plan.quick() ? 100 : 2000;
+  plan.say("LCM loopback latency (" + std::to_string(messages) + " messages)");
+  std::string why;
+  const auto l = measure_lcm_latency(messages, why);
+  if (!l) {
+    plan.add("lcm_latency_p50_us", std::nullopt, "us", why);
+    plan.add("lcm_latency_p99_us", std::nullopt, "us", why);
+    return;
+  }
+  const std::string note = fmt("udpm ttl=0, 256-byte messages, publish in one thread to receive in another, "
+                               "one in flight; %.0f timed, %.0f lost",
+                               static_cast<double>(l->messages), static_cast<double>(l->lost));
+  plan.add("lcm_latency_p50_us", l->p50_us, "us", note);
+  plan.add("lcm_latency_p99_us", l->p99_us, "us", note);
+}
+
+}  // namespace
+
+std::vector<Figure> run_all(const BenchOptions& options) {
+  Plan plan(options);
+  memory_figures(plan);
+
+  plan.say("FMA throughput (peak)");
+  const PeakRate peak = measure_peak(options.quick ? 0.02 : 0.2);
+  plan.add("peak_gflops", peak.flops_per_s * 1e-9, "GFLOP/s", "measured: " + peak.how + ", one thread");
+
+  std::int64_t allocations = 0;
+  std::size_t updates = 0;
+  update_figures(plan, peak, allocations, updates);
+  batch_figures(plan);
+  replay_figure(plan, allocations, updates);
+  plan.add("allocations_per_update", static_cast<double>(allocations) / static_cast<double>(updates), "",
+           fmt("%.0f heap allocations over %.0f timed updates and replay samples (operator new",
+               static_cast<double>(allocations), static_cast<double>(updates)) +
+               (counts_malloc() ? " and malloc counted)" : " counted; malloc not: sanitizer build)"));
+  lcm_figures(plan);
+  return plan.figures;
+}
+
+}  // namespace mpm::bench
