@@ -22,6 +22,7 @@ struct PaperCase {
   const char* paper_result;  // what the paper reports, for the printout
   std::vector<Channel> truth;  // channels that really differ
   bool unstable;             // the paper's unanalysable integrator case
+  std::size_t samples;       // record length the verdict needs in our loop
 };
 
 const std::vector<PaperCase>& paper_cases();
