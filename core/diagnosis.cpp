@@ -1,0 +1,448 @@
+#include "core/diagnosis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "core/chi_square.hpp"
+#include "core/diagnosis_context.hpp"
+#include "core/noise_filter.hpp"
+
+namespace mpm::diagnosis {
+
+double Candidate::bic(double log_n) const { return lr - params * log_n; }
+
+OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std::vector<Vec>& X) {
+  const OutputState& o = cx.out[j];
+  OutputFit f;
+  f.output = j;
+  Vec target = c0.size() ? Vec(o.wd - simulate(o.whitener, c0)) : o.wd;
+  std::vector<Vec> regs;
+  regs.reserve(X.size());
+  for (const Vec& x : X) regs.push_back(simulate(o.whitener, x));
+  f.fit = least_squares(target, regs, cx.seg);
+  f.correction = c0.size() ? c0 : Vec::Zero(o.d.size());
+  for (std::size_t l = 0; l < X.size(); ++l) f.correction += f.fit.theta(static_cast<Index>(l)) * X[l];
+  return f;
+}
+
+double objective(const Context& cx, const std::vector<OutputFit>& fits) {
+  double s = 0.0;
+  for (const auto& f : fits) s += std::log(f.fit.fit_var / cx.out[f.output].fit_var);
+  return s * static_cast<double>(cx.seg.fit_samples());
+}
+
+void score(const Context& cx, Candidate& c) {
+  c.lr = -objective(cx, c.fits);
+  // Out of sample: does the (whitened) correction point along the held-out
+  // residual? z = <e0, w c> / (sigma0 |w c|), N(0, 1) when c is unrelated to
+  // it; and the held-out variance must drop.
+  const Index nh = cx.out.empty() ? 0 : cx.out[0].d.size();
+  double num = 0.0, den = 0.0;
+  c.hold_gain = 0.0;
+  for (const auto& f : c.fits) {
+    const OutputState& o = cx.out[f.output];
+    for (Index k = 0; k < nh; ++k) {
+      if (!cx.seg.hold[static_cast<std::size_t>(k)]) continue;
+      const double wc = o.hold_error(k) - f.fit.hold_error(k);
+      num += o.hold_error(k) * wc / o.hold_var;
+      den += wc * wc / o.hold_var;
+    }
+    c.hold_gain += std::log(o.hold_var / f.fit.hold_var);
+  }
+  c.z_hold = den > 0.0 ? num / std::sqrt(den) : 0.0;
+}
+
+namespace {
+
+// Whitened variances and held-out errors of output j as it stands.
+void refresh(Context& cx, std::size_t j) {
+  OutputState& o = cx.out[j];
+  o.wd = simulate(o.whitener, o.d);
+  const LinearFit f = least_squares(o.wd, {}, cx.seg);
+  o.fit_var = f.fit_var;
+  o.hold_var = f.hold_var;
+  o.hold_error = f.hold_error;
+}
+
+std::vector<int> valid_runs(const std::vector<char>& valid) {
+  std::vector<int> run(valid.size(), 0);
+  for (std::size_t k = 0; k < valid.size(); ++k) run[k] = valid[k] ? (k ? run[k - 1] : 0) + 1 : 0;
+  return run;
+}
+
+struct LagBlock {
+  const Vec* x;
+  int first;
+  int count;
+};
+
+struct Arx {
+  std::vector<double> ar;  // 1, -a1, ...
+  double rss = 0.0;
+  Index rows = 0;
+};
+
+// Least squares of d(k) on [1, d(k-1..k-na), blocks] over the fit part.
+Arx arx(const Context& cx, const Vec& d, int na, const std::vector<LagBlock>& blocks) {
+  const std::vector<int> run = valid_runs(cx.valid);
+  int max_lag = na;
+  Index cols = 1 + na;
+  for (const auto& b : blocks) {
+    max_lag = std::max(max_lag, b.first + b.count - 1);
+    cols += b.count;
+  }
+  std::vector<Index> rows;
+  for (Index k = cx.seg.begin; k < d.size(); ++k)
+    if (cx.seg.fit[static_cast<std::size_t>(k)] && run[static_cast<std::size_t>(k)] > max_lag) rows.push_back(k);
+  Arx out;
+  out.ar.assign(static_cast<std::size_t>(na) + 1, 0.0);
+  out.ar[0] = 1.0;
+  if (static_cast<Index>(rows.size()) < 3 * cols) return out;
+  Eigen::MatrixXd X(static_cast<Index>(rows.size()), cols);
+  Vec y(static_cast<Index>(rows.size()));
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    const Index k = rows[r], i = static_cast<Index>(r);
+    Index c = 0;
+    X(i, c++) = 1.0;
+    for (int l = 1; l <= na; ++l) X(i, c++) = d(k - l);
+    for (const auto& b : blocks)
+      for (int l = b.first; l < b.first + b.count; ++l) X(i, c++) = (*b.x)(k - l);
+    y(i) = d(k);
+  }
+  // Scale columns for conditioning.
+  Vec scale = X.colwise().norm().transpose().cwiseMax(1e-300);
+  const Eigen::MatrixXd Xs = X * scale.cwiseInverse().asDiagonal();
+  const Vec beta = Xs.colPivHouseholderQr().solve(y).cwiseQuotient(scale);
+  out.rss = (y - X * beta).squaredNorm();
+  out.rows = static_cast<Index>(rows.size());
+  for (int l = 1; l <= na; ++l) out.ar[static_cast<std::size_t>(l)] = -beta(l);
+  return out;
+}
+
+std::vector<LagBlock> input_blocks(const Context& cx, std::size_t j, int nb) {
+  std::vector<LagBlock> blocks;
+  for (std::size_t i = 0; i < cx.n_in(); ++i) {
+    if (!cx.excited[i]) continue;
+    const Vec& g = cx.gu[j * cx.n_in() + i];
+    if (g.size()) {
+      blocks.push_back({&g, 1, nb});
+    }
+  }
+  return blocks;
+}
+
+}  // namespace
+
+double signal_granger_lr(const Context& cx, std::size_t j, std::size_t column, int& dof) {
+  const int nb = cx.settings.input_lags;
+  std::vector<LagBlock> blocks = input_blocks(cx, j, nb);
+  // Plain lags of the inputs with no channel (a missing channel).
+  std::vector<Vec> plain;
+  plain.reserve(cx.n_in());
+  for (std::size_t i = 0; i < cx.n_in(); ++i)
+    if (cx.excited[i] && !cx.gu[j * cx.n_in() + i].size()) plain.push_back(cx.problem.du.col(static_cast<Index>(i)));
+  for (const Vec& p : plain) blocks.push_back({&p, 1, nb});
+  const Arx without = arx(cx, cx.out[j].d, cx.settings.ar_order, blocks);
+  const Vec z = cx.extra.col(static_cast<Index>(column));
+  blocks.push_back({&z, 0, nb});
+  const Arx with = arx(cx, cx.out[j].d, cx.settings.ar_order, blocks);
+  dof = nb;
+  if (with.rows == 0 || with.rss <= 0.0) return 0.0;
+  return static_cast<double>(with.rows) * std::log(without.rss / with.rss);
+}
+
+namespace {
+
+Context prepare(const Problem& p, const Settings& s) {
+  Context cx{p, s, {}, {}, {}, {}, {}, {}};
+  const Index n = p.residual.rows();
+  std::vector<char> finite(static_cast<std::size_t>(n), 1);
+  for (Index k = 0; k < n; ++k) {
+    bool ok = p.residual.row(k).allFinite() && p.du.row(k).allFinite();
+    if (p.extra.cols()) ok = ok && p.extra.row(k).allFinite();
+    finite[static_cast<std::size_t>(k)] = ok && k >= static_cast<Index>(p.begin);
+  }
+  const std::vector<int> run = valid_runs(finite);
+  const int settle = 3 * s.ar_order;
+  cx.valid.assign(static_cast<std::size_t>(n), 0);
+  Index first = -1;
+  for (Index k = 0; k < n; ++k) {
+    cx.valid[static_cast<std::size_t>(k)] = run[static_cast<std::size_t>(k)] > settle;
+    if (cx.valid[static_cast<std::size_t>(k)] && first < 0) first = k;
+  }
+  if (first < 0) first = n;
+  cx.seg.begin = first;
+  // Ten blocks; every third one (30 %) held out.
+  cx.seg.fit.assign(static_cast<std::size_t>(n), 0);
+  cx.seg.hold.assign(static_cast<std::size_t>(n), 0);
+  const Index block = std::max<Index>(1, (n - first) / 10);
+  for (Index k = first; k < n; ++k) {
+    if (!cx.valid[static_cast<std::size_t>(k)]) continue;
+    const bool held = std::min<Index>(9, (k - first) / block) % 3 == 2;
+    (held ? cx.seg.hold : cx.seg.fit)[static_cast<std::size_t>(k)] = 1;
+    ++(held ? cx.seg.hold_n : cx.seg.fit_n);
+  }
+
+  cx.excited.assign(p.inputs.size(), false);
+  for (std::size_t i = 0; i < p.inputs.size(); ++i) {
+    const Vec u = p.du.col(static_cast<Index>(i));
+    if (cx.seg.fit_n < 10) continue;
+    const double sd = std::sqrt(variance(u, cx.seg.fit));
+    const double ref = std::max(1.0, u.cwiseAbs().maxCoeff()) * 1e-6;
+    cx.excited[i] = sd > ref;
+  }
+  cx.gu.resize(p.outputs.size() * p.inputs.size());
+  for (std::size_t j = 0; j < p.outputs.size(); ++j)
+    for (std::size_t i = 0; i < p.inputs.size(); ++i)
+      if (cx.has_channel(j, i)) cx.gu[j * p.inputs.size() + i] = simulate(*cx.channel(j, i), p.du.col(static_cast<Index>(i)));
+
+  cx.extra = p.extra;
+  for (Index c = 0; c < cx.extra.cols(); ++c) {
+    double last = 0.0, sum = 0.0;
+    Index cnt = 0;
+    for (Index k = 0; k < n; ++k) {
+      if (std::isfinite(cx.extra(k, c))) last = cx.extra(k, c); else cx.extra(k, c) = last;
+      if (cx.seg.fit[static_cast<std::size_t>(k)]) { sum += cx.extra(k, c); ++cnt; }
+    }
+    cx.extra.col(c).array() -= cnt ? sum / static_cast<double>(cnt) : 0.0;
+  }
+
+  cx.out.resize(p.outputs.size());
+  for (std::size_t j = 0; j < p.outputs.size(); ++j) {
+    OutputState& o = cx.out[j];
+    o.d = p.residual.col(static_cast<Index>(j));
+    double last = 0.0;
+    for (Index k = 0; k < n; ++k) {
+      if (std::isfinite(o.d(k))) last = o.d(k); else o.d(k) = last;
+    }
+    // Remove the fit part's mean: the offset is not a mismatch.
+    double sum = 0.0;
+    Index cnt = 0;
+    for (Index k = cx.seg.begin; k < n; ++k)
+      if (cx.seg.fit[static_cast<std::size_t>(k)]) { sum += o.d(k); ++cnt; }
+    if (cnt) o.d.array() -= sum / static_cast<double>(cnt);
+    if (j < p.noise.size() && p.noise[j]) {
+      o.whitener = inverse(*p.noise[j]);
+    } else {
+      std::vector<LagBlock> blocks = input_blocks(cx, j, s.input_lags);
+      std::vector<Vec> extras;
+      extras.reserve(static_cast<std::size_t>(cx.extra.cols()));
+      for (Index c = 0; c < cx.extra.cols(); ++c) extras.push_back(cx.extra.col(c));
+      for (const Vec& z : extras) blocks.push_back({&z, 0, s.input_lags});
+      const Arx a = arx(cx, o.d, s.ar_order, blocks);
+      o.whitener = DiscreteTf{a.ar, {1.0}, 0};
+    }
+    refresh(cx, j);
+  }
+  return cx;
+}
+
+bool overlaps(const std::set<std::pair<std::size_t, long>>& used, const Finding& f) {
+  for (const auto& c : f.channels) {
+    const long in = c.input ? static_cast<long>(*c.input) : -1;
+    if (in >= 0 && used.count({c.output, in})) return true;
+  }
+  return false;
+}
+
+std::vector<Candidate> generate(const Context& cx, const std::set<std::pair<std::size_t, long>>& used,
+                                const std::set<std::pair<std::size_t, std::size_t>>& used_signals, Progress progress) {
+  std::vector<Candidate> all;
+  for (std::size_t j = 0; j < cx.n_out(); ++j)
+    for (std::size_t i = 0; i < cx.n_in(); ++i)
+      if (!used.count({j, static_cast<long>(i)})) channel_hypotheses(cx, j, i, all);
+  if (progress) progress("channel hypotheses fitted");
+  for (std::size_t i = 0; i < cx.n_in(); ++i) column_hypotheses(cx, i, all);
+  for (std::size_t j = 0; j < cx.n_out(); ++j) row_hypotheses(cx, j, all);
+  if (progress) progress("column and row hypotheses fitted");
+  // A loose screen (5 %, plain lags have little power on slow responses):
+  // the decision is the structured fit's own test below, Bonferroni-corrected.
+  const double pre = chi_square_quantile_upper(0.05, cx.settings.input_lags);
+  for (std::size_t j = 0; j < cx.n_out(); ++j)
+    for (Index c = 0; c < cx.extra.cols(); ++c) {
+      if (used_signals.count({j, static_cast<std::size_t>(c)})) continue;
+      int dof = 0;
+      const double lr = signal_granger_lr(cx, j, static_cast<std::size_t>(c), dof);
+      if (cx.settings.verbose && progress)
+        progress(("  Granger test of " + cx.problem.extra_names[static_cast<std::size_t>(c)] + " -> " +
+                  cx.problem.outputs[j] + ": LR " + fmt(lr, 4) + " (limit " + fmt(pre, 3) + ")").c_str());
+      if (lr > pre) signal_hypotheses(cx, j, static_cast<std::size_t>(c), all);
+    }
+  std::vector<Candidate> keep;
+  for (auto& c : all)
+    if (!overlaps(used, c.finding)) keep.push_back(std::move(c));
+  return keep;
+}
+
+// The fit-part test and the held-out test are independent under "no
+// mismatch", so a candidate passes both with probability (fit level) x
+// (held-out level): the fit level is alpha / hold level, shared over the family.
+double fit_level(const Settings& s, double family) { return s.alpha / s.holdout_level / family; }
+
+bool passes(const Candidate& c, const Settings& s, double family) {
+  return c.lr >= chi_square_quantile_upper(fit_level(s, family), c.params) && c.z_hold >= s.holdout_z && c.hold_gain > 0.0;
+}
+
+// The fit block: one-step prediction-error variances (the whitened residual
+// the fit minimises), summed over the finding's outputs. The raw residual's
+// variance is no measure of fit in closed loop (feedback correlates dG u
+// with the disturbance, so a correct correction can raise it); it is kept
+// in `raw` for the record.
+FitNumbers fit_numbers(const Context& cx, const Candidate& c, FitNumbers& raw) {
+  FitNumbers f;
+  for (const auto& of : c.fits) {
+    const OutputState& o = cx.out[of.output];
+    f.residual_variance_before += o.fit_var;
+    f.residual_variance_after += of.fit.fit_var;
+    f.holdout_variance_before += o.hold_var;
+    f.holdout_variance_after += of.fit.hold_var;
+    const Vec after = o.d - of.correction;
+    raw.residual_variance_before += variance(o.d, cx.seg.fit);
+    raw.residual_variance_after += variance(after, cx.seg.fit);
+    raw.holdout_variance_before += variance(o.d, cx.seg.hold);
+    raw.holdout_variance_after += variance(after, cx.seg.hold);
+  }
+  return f;
+}
+
+void disturbance_models(Context& cx, const std::vector<bool>& explained, Result& r) {
+  const Index n_fit = cx.seg.fit_samples();
+  for (std::size_t j = 0; j < cx.n_out(); ++j) {
+    if (explained[j] || j >= cx.problem.noise.size() || !cx.problem.noise[j]) continue;
+    const OutputState& o = cx.out[j];
+    const int kmax = 3;
+    const double limit_alpha = fit_level(cx.settings, static_cast<double>(kmax * cx.n_out()));
+    std::optional<Candidate> best;
+    std::vector<double> best_ar;
+    for (int k = 1; k <= kmax; ++k) {
+      const std::vector<double> a = fit_ar(o.wd, cx.seg.fit, k);
+      const Vec e = simulate(DiscreteTf{a, {1.0}, 0}, o.wd);
+      const LinearFit f = least_squares(e, {}, cx.seg);
+      Candidate c;
+      c.fits.push_back(OutputFit{j, Vec::Zero(o.d.size()), f});
+      c.params = k;
+      score(cx, c);
+      if (c.lr < chi_square_quantile_upper(limit_alpha, k) || c.z_hold < cx.settings.holdout_z || c.hold_gain <= 0.0) continue;
+      if (!best || c.bic(std::log(static_cast<double>(n_fit))) > best->bic(std::log(static_cast<double>(n_fit)))) {
+        best = std::move(c);
+        best_ar = a;
+      }
+    }
+    if (!best) continue;
+    Finding f;
+    f.channels = {{j, std::nullopt}};
+    f.physics = "disturbance_model";
+    const DiscreteTf& nn = *cx.problem.noise[j];
+    f.nominal = nn;
+    DiscreteTf fitted = nn;
+    fitted.den = poly_mul(nn.den, best_ar);
+    f.fitted = fitted;
+    const double a_var = best->fits[0].fit.fit_var;
+    f.parameters["variance"] = a_var;
+    f.lr = best->lr;
+    f.params = best->params;
+    f.summary = "no input or recorded signal explains " + cx.problem.outputs[j] +
+                "'s residual, but its one-step prediction error is " + fmt(100.0 * (1.0 - a_var / o.fit_var), 2) +
+                " % smaller with a changed disturbance model (AR order " + std::to_string(best->params) + " on N^-1 d)";
+    // Fit numbers: one-step prediction-error variances (the process model is unchanged).
+    f.fit.residual_variance_before = o.fit_var;
+    f.fit.residual_variance_after = a_var;
+    f.fit.holdout_variance_before = o.hold_var;
+    f.fit.holdout_variance_after = best->fits[0].fit.hold_var;
+    const double v = variance(o.d, cx.seg.fit);
+    const double h = variance(o.d, cx.seg.hold);
+    f.raw = {v, v, h, h};
+    r.findings.push_back(std::move(f));
+  }
+}
+
+}  // namespace
+
+Result diagnose(const Problem& problem, const Settings& settings, Progress progress) {
+  Result r;
+  Context cx = prepare(problem, settings);
+  if (cx.seg.fit_samples() < 200 || cx.seg.hold_samples() < 100) {
+    r.notes.push_back("too few usable samples to fit hypotheses");
+    for (bool f : problem.monitor_flag) r.mismatch = r.mismatch || f;
+    return r;
+  }
+  for (std::size_t i = 0; i < cx.n_in(); ++i)
+    if (!cx.excited[i]) r.notes.push_back("input " + problem.inputs[i] + " does not move: its channels are not analysed");
+
+  std::set<std::pair<std::size_t, long>> used;
+  std::set<std::pair<std::size_t, std::size_t>> used_signals;
+  std::vector<bool> explained(cx.n_out(), false);
+  double family = 0.0;
+  const double log_n = std::log(static_cast<double>(cx.seg.fit_samples()));
+  for (int round = 0; round < settings.max_findings; ++round) {
+    std::vector<Candidate> cands = generate(cx, used, used_signals, progress);
+    if (round == 0) family = std::max<double>(1.0, static_cast<double>(cands.size()));
+    // A recorded signal that explains the residual goes first: while it is
+    // in the residual, the controller moves the inputs to cancel it and any
+    // fit of the process channels is biased towards explaining it.
+    bool signal_first = false;
+    for (const auto& c : cands) signal_first = signal_first || (c.finding.signal && passes(c, settings, family));
+    const Candidate* best = nullptr;
+    double best_bic = -std::numeric_limits<double>::infinity();
+    for (const auto& c : cands) {
+      if (settings.verbose && progress) {
+        std::string m = "  candidate " + c.finding.physics + " [";
+        for (const auto& ch : c.finding.channels)
+          m += problem.outputs[ch.output] + "<-" + (ch.input ? problem.inputs[*ch.input] : c.finding.signal.value_or("-")) + " ";
+        m += "] lr " + fmt(c.lr, 4) + " (limit " + fmt(chi_square_quantile_upper(fit_level(settings, family), c.params), 3) +
+             ") z_hold " + fmt(c.z_hold, 3) + " bic " + fmt(c.bic(log_n), 4) + ": " + c.finding.summary;
+        progress(m.c_str());
+      }
+      if (!passes(c, settings, family) || (signal_first && !c.finding.signal)) continue;
+      const double bic = c.bic(log_n);
+      if (bic > best_bic) {
+        best_bic = bic;
+        best = &c;
+      }
+    }
+    if (!best) break;
+    Finding f = best->finding;
+    f.fit = fit_numbers(cx, *best, f.raw);
+    for (const auto& ch : f.channels) {
+      if (ch.input) used.insert({ch.output, static_cast<long>(*ch.input)});
+      explained[ch.output] = true;
+    }
+    if (f.signal)
+      for (std::size_t c = 0; c < problem.extra_names.size(); ++c)
+        if (problem.extra_names[c] == *f.signal) used_signals.insert({f.channels[0].output, c});
+    for (const auto& of : best->fits) {
+      cx.out[of.output].d -= of.correction;
+      refresh(cx, of.output);
+    }
+    r.findings.push_back(std::move(f));
+    if (progress) progress(("accepted: " + r.findings.back().summary).c_str());
+  }
+  disturbance_models(cx, explained, r);
+  for (std::size_t j = 0; j < cx.n_out(); ++j) {
+    if (j < problem.monitor_flag.size() && problem.monitor_flag[j] && !explained[j]) {
+      bool any = false;
+      for (const auto& f : r.findings)
+        for (const auto& c : f.channels) any = any || c.output == j;
+      if (any) continue;
+      Finding f;
+      f.physics = "other";
+      if (j < problem.monitor_located.size())
+        for (std::size_t i : problem.monitor_located[j]) f.channels.push_back({j, i});
+      if (f.channels.empty()) f.channels.push_back({j, std::nullopt});
+      f.summary = "the Granger test locates a mismatch in " + problem.outputs[j] +
+                  " that none of the structured hypotheses explains significantly";
+      const double v = variance(cx.out[j].d, cx.seg.fit);
+      const double h = variance(cx.out[j].d, cx.seg.hold);
+      f.fit = {v, v, h, h};
+      f.raw = f.fit;
+      r.findings.push_back(std::move(f));
+    }
+  }
+  r.mismatch = !r.findings.empty();
+  for (bool f : problem.monitor_flag) r.mismatch = r.mismatch || f;
+  return r;
+}
+
+}  // namespace mpm::diagnosis

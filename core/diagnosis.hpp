@@ -1,0 +1,100 @@
+// OVERVIEW
+// Offline diagnosis of model-plant mismatch: names the physics behind a
+// mismatch by comparing structured hypotheses, each a change of the nominal
+// model with one to three physical parameters (gain, dead time, time
+// constant, extra lag, integrator, missing channel, actuator / sensor lag,
+// saturation, backlash, operating-point gain, an unmodelled recorded signal,
+// a changed disturbance model).
+//
+// Every hypothesis predicts a correction c = (G_P - G_M) u of the residual
+// d~ = y - G_M u. It is scored by prediction-error minimisation of the
+// whitened residual W (d~ - c), W = N^-1 when the plant file gives N, else an
+// AR model of the residual estimated with the inputs in the regression (so
+// that the mismatch does not leak into it). Whitening is what keeps the fit
+// consistent in closed loop (direct prediction-error method).
+// Parameters are fitted on seven of ten interleaved blocks; each candidate must
+// pass a likelihood-ratio test there (chi-square, Bonferroni over all the
+// candidates tried) and improve the prediction on the held-out part
+// (the other three blocks), which it never saw. Candidates are chosen greedily: the best by BIC is
+// accepted, its correction is subtracted, and the rest are refitted.
+#pragma once
+
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "core/diagnosis_signal.hpp"
+#include "core/transfer_function.hpp"
+
+namespace mpm::diagnosis {
+
+struct Settings {
+  double alpha = 1e-3;          // family-wise false-alarm level of accepting a hypothesis
+  double holdout_level = 0.05;  // level of the held-out confirmation (holdout_z is its quantile)
+  double holdout_z = 1.645;     // one-sided 5 % paired test on the held-out part
+  int ar_order = 10;            // AR whitener order when N is unknown
+  int input_lags = 10;          // input lags in the ARX noise estimate / Granger tests
+  int max_findings = 8;
+  int max_extra_delay = 15;     // dead-time search range (samples)
+  bool verbose = false;         // report every candidate through the progress callback
+};
+
+struct Problem {
+  std::vector<std::string> inputs;
+  std::vector<std::string> outputs;
+  Eigen::MatrixXd du;        // samples x inputs: u - u0, missing samples held
+  Eigen::MatrixXd u_abs;     // absolute inputs (reports)
+  Eigen::MatrixXd residual;  // samples x outputs, NaN = missing
+  std::vector<std::string> extra_names;
+  Eigen::MatrixXd extra;     // samples x extra columns (absolute; NaN = missing)
+  std::vector<std::optional<DiscreteTf>> nominal;  // output major; nullopt / zero = no channel
+  std::vector<std::optional<DiscreteTf>> noise;    // per output, N when known
+  std::vector<std::optional<double>> noise_variance;
+  std::size_t begin = 0;           // first sample analysed (after the start-up transient)
+  std::vector<bool> monitor_flag;  // per output: the monitor's verdict (mismatch)
+  std::vector<std::vector<std::size_t>> monitor_located;  // per output: inputs located
+  double sample_time = 1.0;
+};
+
+struct Channel {
+  std::size_t output = 0;
+  std::optional<std::size_t> input;  // nullopt: no input (signal / disturbance)
+};
+
+struct FitNumbers {
+  double residual_variance_before = 0.0;
+  double residual_variance_after = 0.0;
+  double holdout_variance_before = 0.0;
+  double holdout_variance_after = 0.0;
+};
+
+struct Finding {
+  std::vector<Channel> channels;
+  std::string physics;
+  std::optional<std::string> signal;
+  std::string summary;
+  std::optional<DiscreteTf> nominal;
+  std::optional<DiscreteTf> fitted;
+  std::map<std::string, double> parameters;  // extra fields of `fitted`
+  FitNumbers fit;   // one-step prediction-error variances (whitened residual), summed over outputs
+  FitNumbers raw;   // the raw residual's variances, for the record
+  double lr = 0.0;  // likelihood-ratio statistic on the fit part
+  int params = 0;
+};
+
+struct Result {
+  bool mismatch = false;
+  std::vector<Finding> findings;
+  std::vector<std::string> notes;  // why parts were not analysed
+};
+
+// Progress callback for long steps (may be empty).
+using Progress = void (*)(const char* message);
+
+Result diagnose(const Problem& problem, const Settings& settings = {}, Progress progress = nullptr);
+
+}  // namespace mpm::diagnosis

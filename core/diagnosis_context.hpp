@@ -1,0 +1,82 @@
+// Internal to the diagnosis (core/diagnosis*.cpp): the prepared record, how
+// a hypothesis's correction is scored, and the hypothesis generators.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/diagnosis.hpp"
+
+namespace mpm::diagnosis {
+
+// One output's current residual and its whitener.
+struct OutputState {
+  Vec d;               // residual with accepted corrections subtracted (missing: held)
+  DiscreteTf whitener; // N^-1, or the AR part of an ARX fit
+  Vec wd;              // whitener applied to d
+  double fit_var = 1.0;   // whitened variance now, fit part
+  double hold_var = 1.0;  // whitened variance now, held-out part
+  Vec hold_error;         // whitened, mean-removed errors on the held-out part
+};
+
+struct Context {
+  const Problem& problem;
+  const Settings& settings;
+  Segments seg;
+  std::vector<char> valid;       // usable samples (finite, whitener settled)
+  std::vector<OutputState> out;
+  std::vector<Vec> gu;           // per channel (output major): G_ji du_i, empty without a channel
+  Eigen::MatrixXd extra;         // extra columns, deviation from their fit mean, held
+  std::vector<bool> excited;     // per input: moves on the fit part
+  std::size_t n_in() const { return problem.inputs.size(); }
+  std::size_t n_out() const { return problem.outputs.size(); }
+  const std::optional<DiscreteTf>& channel(std::size_t j, std::size_t i) const {
+    return problem.nominal[j * n_in() + i];
+  }
+  bool has_channel(std::size_t j, std::size_t i) const {
+    const auto& c = channel(j, i);
+    return c && !c->is_zero();
+  }
+};
+
+// The fit of one output under a hypothesis: correction c = c0 + sum theta x.
+struct OutputFit {
+  std::size_t output = 0;
+  Vec correction;   // raw, full length
+  LinearFit fit;    // whitened
+};
+
+struct Candidate {
+  Finding finding;
+  std::vector<OutputFit> fits;
+  int params = 0;
+  double lr = 0.0;        // sum over outputs of n_fit ln(before / after), whitened
+  double z_hold = 0.0;    // projection test on the held-out part
+  double hold_gain = 0.0; // sum over outputs of ln(before / after), held-out whitened variance
+  double bic(double log_n) const;  // lr - params ln n
+};
+
+// Fits output j with fixed correction c0 (may be empty) plus linear terms X.
+OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std::vector<Vec>& X);
+// -sum n ln(var): the objective to minimise over nonlinear parameters.
+double objective(const Context& cx, const std::vector<OutputFit>& fits);
+// Fills lr and z_hold.
+void score(const Context& cx, Candidate& c);
+
+// Hypotheses. Each appends its best-fitting candidate(s).
+void channel_hypotheses(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out);
+void column_hypotheses(const Context& cx, std::size_t i, std::vector<Candidate>& out);
+void row_hypotheses(const Context& cx, std::size_t j, std::vector<Candidate>& out);
+void signal_hypotheses(const Context& cx, std::size_t j, std::size_t column, std::vector<Candidate>& out);
+
+// Granger test of extra column `column` on output j's residual, given the
+// inputs: likelihood ratio (chi-square with `dof`).
+double signal_granger_lr(const Context& cx, std::size_t j, std::size_t column, int& dof);
+
+// Pole grid for lags: time constants log-spaced in [tau_lo, tau_hi] samples.
+std::vector<double> lag_pole_grid(double tau_lo, double tau_hi, int points);
+
+std::string fmt(double v, int digits = 3);
+
+}  // namespace mpm::diagnosis

@@ -1,0 +1,222 @@
+// The structured hypotheses of the diagnosis: each is a change of the nominal
+// model with one to three physical parameters, fitted by prediction-error
+// minimisation of the whitened residual on the fit part of the record.
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "core/diagnosis_context.hpp"
+
+namespace mpm::diagnosis {
+namespace {
+
+const std::string& in_name(const Context& cx, std::size_t i) { return cx.problem.inputs[i]; }
+const std::string& out_name(const Context& cx, std::size_t j) { return cx.problem.outputs[j]; }
+std::string arrow(const Context& cx, std::size_t j, std::size_t i) { return in_name(cx, i) + " -> " + out_name(cx, j); }
+
+Candidate make(const Context& cx, std::string physics, std::vector<Channel> channels, std::vector<OutputFit> fits,
+               int params) {
+  Candidate c;
+  c.finding.physics = std::move(physics);
+  c.finding.channels = std::move(channels);
+  c.fits = std::move(fits);
+  c.params = params;
+  c.finding.params = params;
+  score(cx, c);
+  c.finding.lr = c.lr;
+  return c;
+}
+
+double tau_of(double pole) { return pole > 0.0 && pole < 1.0 ? -1.0 / std::log(pole) : 0.0; }
+
+// G with its slowest pole p replaced by p2; gain_scale multiplies num.
+DiscreteTf move_pole(const DiscreteTf& g, double p, double p2, double gain_scale) {
+  DiscreteTf out = g;
+  out.den = poly_mul(deflate(g.den, p), {1.0, -p2});
+  for (double& b : out.num) b *= gain_scale;
+  return out;
+}
+
+void gain(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+  const Vec& x = cx.gu[j * cx.n_in() + i];
+  OutputFit f = fit_output(cx, j, Vec(), {x});
+  const double k = 1.0 + f.fit.theta(0), se = f.fit.theta_se(0);
+  Candidate c = make(cx, "gain", {{j, i}}, {std::move(f)}, 1);
+  const DiscreteTf& g = *cx.channel(j, i);
+  DiscreteTf fitted = g;
+  for (double& b : fitted.num) b *= k;
+  c.finding.nominal = g;
+  c.finding.fitted = fitted;
+  c.finding.parameters["gain_factor"] = k;
+  c.finding.summary = "gain of " + arrow(cx, j, i) + " is " + fmt(k) + " x nominal (95% CI " + fmt(k - 1.96 * se) +
+                      "-" + fmt(k + 1.96 * se) + ")";
+  out.push_back(std::move(c));
+}
+
+void dead_time(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+  const Vec& x = cx.gu[j * cx.n_in() + i];
+  const DiscreteTf& g = *cx.channel(j, i);
+  int best = 0;
+  double best_obj = std::numeric_limits<double>::infinity();
+  for (int s = -g.delay; s <= cx.settings.max_extra_delay; ++s) {
+    if (s == 0) continue;
+    const double o = objective(cx, {fit_output(cx, j, shifted(x, s) - x, {})});
+    if (o < best_obj) {
+      best_obj = o;
+      best = s;
+    }
+  }
+  if (best == 0) return;
+  Candidate c = make(cx, "dead_time", {{j, i}}, {fit_output(cx, j, shifted(x, best) - x, {})}, 1);
+  DiscreteTf fitted = g;
+  fitted.delay += best;
+  c.finding.nominal = g;
+  c.finding.fitted = fitted;
+  c.finding.parameters["extra_delay_samples"] = best;
+  c.finding.summary = "dead time of " + arrow(cx, j, i) + " is " + std::to_string(fitted.delay) + " samples (" +
+                      fmt(fitted.delay * cx.problem.sample_time) + " s), nominal " + std::to_string(g.delay);
+  out.push_back(std::move(c));
+}
+
+void time_constant(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+  const DiscreteTf& g = *cx.channel(j, i);
+  const double p = slowest_pole(g);
+  if (p < 0.2) return;
+  const Vec& x = cx.gu[j * cx.n_in() + i];
+  const Vec u = cx.problem.du.col(static_cast<Index>(i));
+  const double tau = tau_of(p);
+  auto corr = [&](double log_ratio) {
+    const double p2 = std::exp(-1.0 / (tau * std::exp(log_ratio)));
+    return Vec(simulate(move_pole(g, p, p2, (1.0 - p2) / (1.0 - p)), u) - x);
+  };
+  std::vector<double> grid;
+  for (int k = 0; k <= 16; ++k) grid.push_back(std::log(0.25) + k * (std::log(4.0) - std::log(0.25)) / 16.0);
+  const double lr = minimise_on_grid(grid, [&](double v) { return objective(cx, {fit_output(cx, j, corr(v), {})}); });
+  const double p2 = std::exp(-1.0 / (tau * std::exp(lr)));
+  Candidate c = make(cx, "time_constant", {{j, i}}, {fit_output(cx, j, corr(lr), {})}, 1);
+  c.finding.nominal = g;
+  c.finding.fitted = move_pole(g, p, p2, (1.0 - p2) / (1.0 - p));
+  c.finding.parameters["time_constant_ratio"] = std::exp(lr);
+  c.finding.summary = "dominant time constant of " + arrow(cx, j, i) + " is " + fmt(std::exp(lr)) + " x nominal (" +
+                      fmt(tau * std::exp(lr) * cx.problem.sample_time) + " s vs " + fmt(tau * cx.problem.sample_time) +
+                      " s), gain kept";
+  out.push_back(std::move(c));
+}
+
+void extra_lag(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+  const DiscreteTf& g = *cx.channel(j, i);
+  const Vec& x = cx.gu[j * cx.n_in() + i];
+  const double tau_nom = std::max(2.0, tau_of(slowest_pole(g)));
+  const auto grid = lag_pole_grid(0.3, tau_nom, 16);
+  auto corr = [&](double a) { return Vec(simulate(unit_lag(a), x) - x); };
+  const double a = minimise_on_grid(grid, [&](double v) { return objective(cx, {fit_output(cx, j, corr(v), {})}); });
+  if (a <= 0.0) return;
+  Candidate c = make(cx, "unmodeled_dynamics", {{j, i}}, {fit_output(cx, j, corr(a), {})}, 1);
+  c.finding.nominal = g;
+  c.finding.fitted = series(g, unit_lag(a));
+  c.finding.parameters["extra_lag_pole"] = a;
+  c.finding.summary = arrow(cx, j, i) + " has an extra lag of " + fmt(tau_of(a) * cx.problem.sample_time) +
+                      " s (pole " + fmt(a) + ") the model lacks";
+  out.push_back(std::move(c));
+}
+
+void integrator(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+  const DiscreteTf& g = *cx.channel(j, i);
+  if (g.has_integrator()) return;
+  const double p = slowest_pole(g);
+  if (p < 0.5) return;
+  const DiscreteTf gi = move_pole(g, p, 1.0, 1.0);
+  const Vec xi = simulate(gi, cx.problem.du.col(static_cast<Index>(i)));
+  const Vec& x = cx.gu[j * cx.n_in() + i];
+  OutputFit f = fit_output(cx, j, -x, {xi});
+  const double k = f.fit.theta(0);
+  Candidate c = make(cx, "integrator", {{j, i}}, {std::move(f)}, 1);
+  c.finding.nominal = g;
+  c.finding.fitted = move_pole(g, p, 1.0, k);
+  c.finding.parameters["integrator_gain_per_sample"] = k * g.dc_gain() * (1.0 - p);
+  c.finding.summary = arrow(cx, j, i) + " integrates: slowest pole " + fmt(p) + " -> 1, gain x " + fmt(k);
+  out.push_back(std::move(c));
+}
+
+// First order plus dead time from signal x to output j: K (1-a)/(1-a q^-1) q^-delay.
+struct Fopdt {
+  double pole = 0.0;
+  int delay = 0;
+};
+Fopdt best_fopdt(const Context& cx, std::size_t j, const Vec& x, int min_delay, int max_delay) {
+  Fopdt best;
+  double best_obj = std::numeric_limits<double>::infinity();
+  std::vector<double> poles{0.0};
+  for (double a : lag_pole_grid(0.5, 200.0, 14)) poles.push_back(a);
+  for (double a : poles) {
+    const Vec lagged = simulate(unit_lag(a), x);
+    for (int d = min_delay; d <= max_delay; ++d) {
+      const double o = objective(cx, {fit_output(cx, j, Vec(), {shifted(lagged, d)})});
+      if (o < best_obj) {
+        best_obj = o;
+        best = {a, d};
+      }
+    }
+  }
+  // refine the pole at the best delay
+  std::vector<double> fine;
+  const double t0 = std::max(0.3, tau_of(best.pole));
+  for (int k = -4; k <= 4; ++k) fine.push_back(std::exp(-1.0 / (t0 * std::pow(1.35, k))));
+  if (best.pole == 0.0) fine.insert(fine.begin(), 0.0);
+  best.pole = minimise_on_grid(fine, [&](double a) {
+    return objective(cx, {fit_output(cx, j, Vec(), {shifted(simulate(unit_lag(a), x), best.delay)})});
+  });
+  return best;
+}
+
+void missing_channel(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+  const Vec u = cx.problem.du.col(static_cast<Index>(i));
+  const Fopdt f = best_fopdt(cx, j, u, 0, 20);
+  OutputFit fit = fit_output(cx, j, Vec(), {shifted(simulate(unit_lag(f.pole), u), f.delay)});
+  const double k = fit.fit.theta(0);
+  Candidate c = make(cx, "missing_channel", {{j, i}}, {std::move(fit)}, 3);
+  DiscreteTf nominal;
+  if (cx.channel(j, i)) nominal = *cx.channel(j, i);
+  DiscreteTf fitted;
+  fitted.num = {k * (1.0 - f.pole)};
+  fitted.den = {1.0, -f.pole};
+  fitted.delay = f.delay;
+  c.finding.nominal = nominal;
+  c.finding.fitted = fitted;
+  c.finding.summary = "the model has no " + arrow(cx, j, i) + " channel; the plant responds with gain " + fmt(k) +
+                      ", time constant " + fmt(tau_of(f.pole) * cx.problem.sample_time) + " s, delay " +
+                      std::to_string(f.delay) + " samples";
+  out.push_back(std::move(c));
+}
+
+}  // namespace
+
+std::vector<double> lag_pole_grid(double tau_lo, double tau_hi, int points) {
+  std::vector<double> g;
+  for (int k = 0; k < points; ++k) {
+    const double t = tau_lo * std::pow(tau_hi / tau_lo, static_cast<double>(k) / (points - 1));
+    g.push_back(std::exp(-1.0 / t));
+  }
+  return g;
+}
+
+std::string fmt(double v, int digits) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*g", digits, v);
+  return b;
+}
+
+void channel_hypotheses(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+  if (!cx.excited[i]) return;
+  if (!cx.has_channel(j, i)) {
+    missing_channel(cx, j, i, out);
+    return;
+  }
+  gain(cx, j, i, out);
+  dead_time(cx, j, i, out);
+  time_constant(cx, j, i, out);
+  extra_lag(cx, j, i, out);
+  integrator(cx, j, i, out);
+}
+
+}  // namespace mpm::diagnosis

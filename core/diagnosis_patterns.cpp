@@ -1,0 +1,213 @@
+// Hypotheses that span several channels (one input's column: actuator lag,
+// saturation, backlash, operating-point gain; one output's row: sensor lag)
+// and recorded signals the model leaves out (unmodeled_input).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/diagnosis_context.hpp"
+
+namespace mpm::diagnosis {
+namespace {
+
+std::vector<std::size_t> column_outputs(const Context& cx, std::size_t i) {
+  std::vector<std::size_t> js;
+  for (std::size_t j = 0; j < cx.n_out(); ++j)
+    if (cx.has_channel(j, i)) js.push_back(j);
+  return js;
+}
+
+std::vector<Channel> column_channels(const std::vector<std::size_t>& js, std::size_t i) {
+  std::vector<Channel> cs;
+  for (std::size_t j : js) cs.push_back({j, i});
+  return cs;
+}
+
+// Corrections G_ji (v - du_i) for every output of the column.
+std::vector<OutputFit> input_change_fits(const Context& cx, std::size_t i, const std::vector<std::size_t>& js,
+                                         const Vec& v) {
+  const Vec delta = v - cx.problem.du.col(static_cast<Index>(i));
+  std::vector<OutputFit> fits;
+  for (std::size_t j : js) fits.push_back(fit_output(cx, j, simulate(*cx.channel(j, i), delta), {}));
+  return fits;
+}
+
+Candidate make(const Context& cx, std::string physics, std::vector<Channel> channels, std::vector<OutputFit> fits,
+               int params) {
+  Candidate c;
+  c.finding.physics = std::move(physics);
+  c.finding.channels = std::move(channels);
+  c.fits = std::move(fits);
+  c.params = params;
+  c.finding.params = params;
+  score(cx, c);
+  c.finding.lr = c.lr;
+  return c;
+}
+
+double tau_of(double pole) { return pole > 0.0 && pole < 1.0 ? -1.0 / std::log(pole) : 0.0; }
+
+void actuator(const Context& cx, std::size_t i, const std::vector<std::size_t>& js, std::vector<Candidate>& out) {
+  const Vec u = cx.problem.du.col(static_cast<Index>(i));
+  auto fits = [&](double a) { return input_change_fits(cx, i, js, simulate(unit_lag(a), u)); };
+  const double a = minimise_on_grid(lag_pole_grid(0.3, 30.0, 16), [&](double v) { return objective(cx, fits(v)); });
+  Candidate c = make(cx, "actuator_dynamics", column_channels(js, i), fits(a), 1);
+  c.finding.nominal = *cx.channel(js[0], i);
+  c.finding.fitted = series(*cx.channel(js[0], i), unit_lag(a));
+  c.finding.parameters["actuator_lag_pole"] = a;
+  c.finding.parameters["actuator_time_constant"] = tau_of(a) * cx.problem.sample_time;
+  c.finding.summary = "actuator of " + cx.problem.inputs[i] + " lags with time constant " +
+                      fmt(tau_of(a) * cx.problem.sample_time) + " s (pole " + fmt(a) + ") on every channel";
+  out.push_back(std::move(c));
+}
+
+void saturation(const Context& cx, std::size_t i, const std::vector<std::size_t>& js, std::vector<Candidate>& out) {
+  const Vec u = cx.problem.du.col(static_cast<Index>(i));
+  std::vector<double> sorted;
+  for (Index k = 0; k < u.size(); ++k)
+    if (cx.seg.fit[static_cast<std::size_t>(k)]) sorted.push_back(u(k));
+  std::sort(sorted.begin(), sorted.end());
+  auto quantile = [&](double q) { return sorted[static_cast<std::size_t>(q * static_cast<double>(sorted.size() - 1))]; };
+  double best_obj = std::numeric_limits<double>::infinity(), best_limit = 0.0;
+  bool upper = true;
+  for (int side = 0; side < 2; ++side) {
+    std::vector<double> grid;
+    for (int k = 0; k <= 12; ++k) grid.push_back(side == 0 ? 0.5 + 0.49 * k / 12.0 : 0.5 - 0.49 * k / 12.0);
+    auto f = [&](double q) {
+      const double lim = quantile(std::clamp(q, 0.0, 1.0));
+      const Vec v = side == 0 ? clipped(u, -1e300, lim) : clipped(u, lim, 1e300);
+      return objective(cx, input_change_fits(cx, i, js, v));
+    };
+    const double q = minimise_on_grid(grid, f);
+    const double o = f(q);
+    if (o < best_obj) {
+      best_obj = o;
+      best_limit = quantile(std::clamp(q, 0.0, 1.0));
+      upper = side == 0;
+    }
+  }
+  const Vec v = upper ? clipped(u, -1e300, best_limit) : clipped(u, best_limit, 1e300);
+  Candidate c = make(cx, "saturation", column_channels(js, i), input_change_fits(cx, i, js, v), 1);
+  const double u0 = cx.problem.u_abs(0, static_cast<Index>(i)) - cx.problem.du(0, static_cast<Index>(i));
+  c.finding.nominal = *cx.channel(js[0], i);
+  c.finding.fitted = *cx.channel(js[0], i);
+  c.finding.parameters[upper ? "upper_limit" : "lower_limit"] = u0 + best_limit;
+  c.finding.summary = cx.problem.inputs[i] + " stops acting " + (upper ? "above " : "below ") + fmt(u0 + best_limit, 4) +
+                      " (the model knows no limit there)";
+  out.push_back(std::move(c));
+}
+
+void deadband(const Context& cx, std::size_t i, const std::vector<std::size_t>& js, std::vector<Candidate>& out) {
+  const Vec u = cx.problem.du.col(static_cast<Index>(i));
+  const Vec moves = (u.tail(u.size() - 1) - u.head(u.size() - 1)).cwiseAbs();
+  const double scale = std::max(1e-12, moves.mean());
+  std::vector<double> grid;
+  for (int k = 0; k <= 14; ++k) grid.push_back(std::log(0.05 * scale) + k * std::log(200.0) / 14.0);
+  auto fits = [&](double lw) { return input_change_fits(cx, i, js, backlash(u, std::exp(lw))); };
+  const double lw = minimise_on_grid(grid, [&](double v) { return objective(cx, fits(v)); });
+  Candidate c = make(cx, "deadband", column_channels(js, i), fits(lw), 1);
+  c.finding.nominal = *cx.channel(js[0], i);
+  c.finding.fitted = *cx.channel(js[0], i);
+  c.finding.parameters["backlash_width"] = std::exp(lw);
+  c.finding.summary = cx.problem.inputs[i] + " has a backlash (deadband) of total width " + fmt(std::exp(lw)) +
+                      ": reversals smaller than that do nothing";
+  out.push_back(std::move(c));
+}
+
+void nonlinear_gain(const Context& cx, std::size_t i, const std::vector<std::size_t>& js, std::vector<Candidate>& out) {
+  // Gain varying linearly with the input's level: effective input du + b du^2.
+  const Vec u = cx.problem.du.col(static_cast<Index>(i));
+  const Vec u2 = u.cwiseProduct(u);
+  std::vector<OutputFit> fits;
+  for (std::size_t j : js) fits.push_back(fit_output(cx, j, Vec(), {simulate(*cx.channel(j, i), u2)}));
+  const double b = fits[0].fit.theta(0);
+  Candidate c = make(cx, "nonlinear_gain", column_channels(js, i), std::move(fits), static_cast<int>(js.size()));
+  c.finding.nominal = *cx.channel(js[0], i);
+  c.finding.fitted = *cx.channel(js[0], i);
+  c.finding.parameters["gain_slope_per_unit"] = 2.0 * b;
+  c.finding.summary = "gain of " + cx.problem.inputs[i] + " changes with its level (relative slope " + fmt(2.0 * b) +
+                      " per unit of " + cx.problem.inputs[i] + ")";
+  out.push_back(std::move(c));
+}
+
+}  // namespace
+
+void column_hypotheses(const Context& cx, std::size_t i, std::vector<Candidate>& out) {
+  if (!cx.excited[i]) return;
+  const auto js = column_outputs(cx, i);
+  if (js.empty()) return;
+  if (js.size() >= 2) actuator(cx, i, js, out);
+  saturation(cx, i, js, out);
+  deadband(cx, i, js, out);
+  nonlinear_gain(cx, i, js, out);
+}
+
+void row_hypotheses(const Context& cx, std::size_t j, std::vector<Candidate>& out) {
+  std::vector<Channel> cs;
+  Vec total = Vec::Zero(cx.problem.du.rows());
+  for (std::size_t i = 0; i < cx.n_in(); ++i)
+    if (cx.has_channel(j, i) && cx.excited[i]) {
+      cs.push_back({j, i});
+      total += cx.gu[j * cx.n_in() + i];
+    }
+  if (cs.size() < 2) return;
+  auto fits = [&](double a) { return std::vector<OutputFit>{fit_output(cx, j, simulate(unit_lag(a), total) - total, {})}; };
+  const double a = minimise_on_grid(lag_pole_grid(0.3, 30.0, 16), [&](double v) { return objective(cx, fits(v)); });
+  Candidate c = make(cx, "sensor_dynamics", cs, fits(a), 1);
+  c.finding.nominal = *cx.channel(j, cs[0].input.value());
+  c.finding.fitted = series(*cx.channel(j, cs[0].input.value()), unit_lag(a));
+  c.finding.parameters["sensor_lag_pole"] = a;
+  c.finding.parameters["sensor_time_constant"] = tau_of(a) * cx.problem.sample_time;
+  c.finding.summary = "sensor of " + cx.problem.outputs[j] + " lags with time constant " +
+                      fmt(tau_of(a) * cx.problem.sample_time) + " s (pole " + fmt(a) + ")";
+  out.push_back(std::move(c));
+}
+
+void signal_hypotheses(const Context& cx, std::size_t j, std::size_t column, std::vector<Candidate>& out) {
+  const Vec z = cx.extra.col(static_cast<Index>(column));
+  const std::string& name = cx.problem.extra_names[column];
+  // (a) first order plus dead time; (b) the signal acts through an input's
+  // nominal channel (a disturbance entering where that input enters).
+  for (std::size_t i = 0; i < cx.n_in(); ++i) {
+    if (!cx.has_channel(j, i)) continue;
+    std::vector<OutputFit> f{fit_output(cx, j, Vec(), {simulate(*cx.channel(j, i), z)})};
+    DiscreteTf tf = *cx.channel(j, i);
+    for (double& b : tf.num) b *= f[0].fit.theta(0);
+    const std::string how = "acts like " + cx.problem.inputs[i] + " (through its channel, x " + fmt(f[0].fit.theta(0)) + ")";
+    Candidate c = make(cx, "unmodeled_input", {{j, std::nullopt}}, std::move(f), 1);
+    c.finding.signal = name;
+    c.finding.fitted = tf;
+    c.finding.summary = "recorded signal " + name + " drives " + cx.problem.outputs[j] + ": it " + how;
+    out.push_back(std::move(c));
+  }
+  const auto fo = [&] {
+    struct R { double pole; int delay; };
+    double bo = std::numeric_limits<double>::infinity();
+    R r{0.0, 0};
+    std::vector<double> poles{0.0};
+    for (double a : lag_pole_grid(0.5, 200.0, 14)) poles.push_back(a);
+    for (double a : poles) {
+      const Vec lagged = simulate(unit_lag(a), z);
+      for (int d = 0; d <= cx.settings.max_extra_delay; ++d) {
+        const double o = objective(cx, {fit_output(cx, j, Vec(), {shifted(lagged, d)})});
+        if (o < bo) { bo = o; r = {a, d}; }
+      }
+    }
+    return r;
+  }();
+  std::vector<OutputFit> f{fit_output(cx, j, Vec(), {shifted(simulate(unit_lag(fo.pole), z), fo.delay)})};
+  const double k = f[0].fit.theta(0);
+  DiscreteTf tf;
+  tf.num = {k * (1.0 - fo.pole)};
+  tf.den = {1.0, -fo.pole};
+  tf.delay = fo.delay;
+  Candidate c = make(cx, "unmodeled_input", {{j, std::nullopt}}, std::move(f), 3);
+  c.finding.signal = name;
+  c.finding.fitted = tf;
+  c.finding.summary = "recorded signal " + name + " drives " + cx.problem.outputs[j] + " through gain " + fmt(k) +
+                      ", time constant " + fmt(tau_of(fo.pole) * cx.problem.sample_time) + " s, delay " +
+                      std::to_string(fo.delay) + " samples";
+  out.push_back(std::move(c));
+}
+
+}  // namespace mpm::diagnosis

@@ -1,0 +1,96 @@
+// Signal helpers for the offline diagnosis (`mpm diagnose`): whole-record
+// filtering, polynomial algebra on channels, input nonlinearities, and the
+// least-squares fit of a whitened residual. Offline code: allocation allowed.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "core/transfer_function.hpp"
+
+namespace mpm::diagnosis {
+
+using Vec = Eigen::VectorXd;
+using Index = Eigen::Index;
+
+// Which samples a fit may use and which are kept back to judge it:
+// interleaved blocks, so that the held-out part sees the same operating
+// conditions (a contiguous tail can be a part where nothing moves).
+struct Segments {
+  std::vector<char> fit;    // per sample: used for fitting
+  std::vector<char> hold;   // per sample: held out
+  Index begin = 0;          // first usable sample
+  Index fit_n = 0;
+  Index hold_n = 0;
+  Index fit_samples() const { return fit_n; }
+  Index hold_samples() const { return hold_n; }
+};
+
+// tf applied to x from rest (x must be finite).
+Vec simulate(const DiscreteTf& tf, const Vec& x);
+// x(k - lag) with zeros before the start (lag may be negative: an advance).
+Vec shifted(const Vec& x, int lag);
+// Effective input of a valve with backlash of total width `width`.
+Vec backlash(const Vec& u, double width);
+Vec clipped(const Vec& u, double lo, double hi);
+
+// Polynomial product (ascending powers of q^-1).
+std::vector<double> poly_mul(const std::vector<double>& a, const std::vector<double>& b);
+// Cascade of two channels.
+DiscreteTf series(const DiscreteTf& a, const DiscreteTf& b);
+// Unit-gain first-order lag (1 - a) / (1 - a q^-1).
+DiscreteTf unit_lag(double pole);
+// The real pole of largest magnitude below 1 (the slowest stable mode), 0 when
+// the channel is static. Found from the companion matrix of den.
+double slowest_pole(const DiscreteTf& tf);
+// den / (1 - p q^-1) when p is a root of den (remainder dropped).
+std::vector<double> deflate(const std::vector<double>& den, double p);
+
+// Least-squares AR(order) polynomial A(q) = 1 - a_1 q^-1 - ... fitted to x on
+// the samples of `mask` (with an intercept).
+std::vector<double> fit_ar(const Vec& x, const std::vector<char>& mask, int order);
+
+// Variance about the mean of x over the samples of `mask`.
+double variance(const Vec& x, const std::vector<char>& mask);
+
+// Result of regressing a whitened target on whitened regressors plus an
+// intercept, fitted on the fit part only.
+struct LinearFit {
+  Vec theta;               // one per regressor (intercept not included)
+  Vec theta_se;            // standard errors of theta
+  double fit_var = 0.0;    // error variance on the fit part
+  double hold_var = 0.0;   // error variance on the held-out part (about its own mean)
+  Vec hold_error;          // full length: mean-removed errors on held-out samples, 0 elsewhere
+};
+LinearFit least_squares(const Vec& target, const std::vector<Vec>& regressors, const Segments& seg);
+
+// Minimises f over a grid and refines the best point by golden section
+// between its neighbours. Returns the argument.
+template <typename F>
+double minimise_on_grid(const std::vector<double>& grid, F&& f) {
+  std::size_t best = 0;
+  std::vector<double> v(grid.size());
+  for (std::size_t g = 0; g < grid.size(); ++g) {
+    v[g] = f(grid[g]);
+    if (v[g] < v[best]) best = g;
+  }
+  if (grid.size() < 3) return grid[best];
+  double lo = grid[best == 0 ? 0 : best - 1], hi = grid[best + 1 == grid.size() ? best : best + 1];
+  const double r = 0.6180339887498949;
+  double x1 = hi - r * (hi - lo), x2 = lo + r * (hi - lo);
+  double f1 = f(x1), f2 = f(x2);
+  for (int it = 0; it < 14; ++it) {
+    if (f1 < f2) {
+      hi = x2; x2 = x1; f2 = f1; x1 = hi - r * (hi - lo); f1 = f(x1);
+    } else {
+      lo = x1; x1 = x2; f1 = f2; x2 = lo + r * (hi - lo); f2 = f(x2);
+    }
+  }
+  const double xm = f1 < f2 ? x1 : x2;
+  return std::min(f1, f2) < v[best] ? xm : grid[best];
+}
+
+}  // namespace mpm::diagnosis

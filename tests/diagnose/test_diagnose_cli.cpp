@@ -1,0 +1,103 @@
+// `mpm diagnose` on simulated recordings with known truth: the report keeps
+// the contract of formats.md section 3 and names the planted mismatch.
+#include <cstdlib>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace {
+
+const std::string kMpm = std::string(MPM_BINARY_DIR) + "/daemon/mpm";
+const std::string kWoodBerry = std::string(MPM_SOURCE_DIR) + "/config/wood-berry.yaml";
+
+std::string tmp_path(const std::string& name) {
+  return (::testing::TempDir().empty() ? std::string("/tmp/") : ::testing::TempDir()) + "mpm_diag_" + name;
+}
+
+int run(const std::string& cmd) { return std::system((cmd + " >/dev/null 2>&1").c_str()); }
+
+std::string read(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// Simulates a scenario and diagnoses it; returns the report text.
+std::string diagnose_scenario(const std::string& scenario, int seed, int samples = 3000) {
+  const std::string csv = tmp_path(scenario + ".csv"), out = tmp_path(scenario + ".json");
+  EXPECT_EQ(run(kMpm + " simulate --scenario " + scenario + " --samples " + std::to_string(samples) + " --seed " +
+                std::to_string(seed) + " --out " + csv),
+            0);
+  EXPECT_EQ(run(kMpm + " diagnose --quiet --plant " + kWoodBerry + " --data " + csv + " --json " + out), 0);
+  return read(out);
+}
+
+std::set<std::string> physics_words(const std::string& report) {
+  std::set<std::string> words;
+  const std::regex re("\"physics\": \"([a-z_]+)\"");
+  for (auto it = std::sregex_iterator(report.begin(), report.end(), re); it != std::sregex_iterator(); ++it)
+    words.insert((*it)[1]);
+  return words;
+}
+
+bool names_channel(const std::string& report, const std::string& output, const std::string& input) {
+  return report.find("{\"output\": \"" + output + "\", \"input\": " + input + "}") != std::string::npos;
+}
+
+TEST(DiagnoseCli, ReportKeepsTheContract) {
+  const std::string r = diagnose_scenario("wood-berry-g12-dead-time", 21);
+  EXPECT_NE(r.find("\"schema\": \"mpm.diagnosis/1\""), std::string::npos);
+  EXPECT_NE(r.find("\"samples\": 3000"), std::string::npos);
+  for (const char* y : {"y1", "y2"}) EXPECT_NE(r.find("{\"output\": \"" + std::string(y) + "\", \"mismatch\""), std::string::npos);
+  for (const char* key : {"\"granger\": [", "\"gamma\": [", "\"findings\": [", "\"residual_variance\"",
+                          "\"holdout_variance_after\"", "\"p_value\""})
+    EXPECT_NE(r.find(key), std::string::npos) << key;
+  const std::set<std::string> vocabulary{"gain", "time_constant", "dead_time", "integrator", "missing_channel",
+                                         "unmodeled_dynamics", "actuator_dynamics", "sensor_dynamics", "saturation",
+                                         "deadband", "nonlinear_gain", "unmodeled_input", "disturbance_model", "other"};
+  for (const auto& w : physics_words(r)) EXPECT_TRUE(vocabulary.count(w)) << w;
+}
+
+TEST(DiagnoseCli, DeadTimeOfG12IsNamed) {
+  const std::string r = diagnose_scenario("wood-berry-g12-dead-time", 22);
+  EXPECT_NE(r.find("\"mismatch\": true"), std::string::npos);
+  EXPECT_TRUE(physics_words(r).count("dead_time"));
+  EXPECT_TRUE(names_channel(r, "y1", "\"u2\""));
+}
+
+TEST(DiagnoseCli, ActuatorLagOfU2IsNamedOnItsColumn) {
+  const std::string r = diagnose_scenario("wood-berry-actuator-u2", 23);
+  EXPECT_TRUE(physics_words(r).count("actuator_dynamics"));
+  EXPECT_TRUE(names_channel(r, "y1", "\"u2\""));
+  EXPECT_TRUE(names_channel(r, "y2", "\"u2\""));
+}
+
+TEST(DiagnoseCli, RecordedFeedFlowIsAnUnmodeledInput) {
+  const std::string r = diagnose_scenario("wood-berry-feed-flow", 24);
+  EXPECT_TRUE(physics_words(r).count("unmodeled_input"));
+  EXPECT_NE(r.find("\"signal\": \"feed_flow\""), std::string::npos);
+  EXPECT_FALSE(names_channel(r, "y1", "\"u1\""));
+}
+
+TEST(DiagnoseCli, NominalPlantGivesNoFinding) {
+  for (int seed : {25, 26}) {
+    const std::string r = diagnose_scenario("wood-berry-nominal", seed);
+    EXPECT_NE(r.find("\"mismatch\": false"), std::string::npos) << "seed " << seed;
+    EXPECT_TRUE(physics_words(r).empty()) << "seed " << seed;
+  }
+}
+
+TEST(DiagnoseCli, ErrorsNameTheFileAndUseExitCodes) {
+  EXPECT_EQ(WEXITSTATUS(run(kMpm + " diagnose --plant " + kWoodBerry)), 2);                       // --data missing
+  EXPECT_EQ(WEXITSTATUS(run(kMpm + " diagnose --plant " + kWoodBerry + " --data /nonexistent.csv")), 1);
+  const std::string err = tmp_path("err.txt");
+  std::system((kMpm + " diagnose --plant " + kWoodBerry + " --data /nonexistent.csv 2>" + err).c_str());
+  EXPECT_NE(read(err).find("/nonexistent.csv"), std::string::npos);
+}
+
+}  // namespace
