@@ -11,6 +11,14 @@ namespace mpm {
 namespace {
 
 constexpr double kRegularization = 1e-9;
+// From this many inputs on, the conditional statistics come from the Wald
+// identity on a tracked inverse factor (O(p nb^2) per input, the inverse
+// doubling the full model's update) instead of re-triangularisation
+// (O(p^2 nb) per input); below it the extra update costs more than it saves.
+constexpr std::size_t kWaldMinInputs = 4;
+// Models updated together (see SqrtRls::update_staged): enough independent
+// rotation chains to hide the square-root and division latency.
+constexpr std::size_t kLockstep = 8;
 // Divergence: the residual's short-memory variance exceeds this many times
 // the matched-model variance (amplitude x 10), or, where that is unknown,
 // 1000 times the quietest level it had: the loop is not stationary and a
@@ -87,12 +95,11 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
     lags_needed_ = std::max(lags_needed_, static_cast<int>(nb_) + static_cast<int>(std::ceil(std::log(0.01) / std::log(settings.input_pole))));
   warmup_ = settings.warmup > 0 ? settings.warmup : static_cast<int>(10 * p_full);
 
-  full_.assign(n_outputs, SqrtRls(p_full, settings.forgetting, kRegularization));
-  pairwise_.assign(n_outputs * n_inputs, SqrtRls(p_pair, settings.forgetting, kRegularization));
+  full_.assign(n_outputs, SqrtRls(p_full, settings.forgetting, kRegularization, n_inputs >= kWaldMinInputs));
+  // The pairwise model of input 1, [1, AR, u_1], is a prefix of the full one.
+  pairwise_.assign(n_outputs * (n_inputs - 1), SqrtRls(p_pair, settings.forgetting, kRegularization));
   residual_lags_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(na_), static_cast<Eigen::Index>(n_outputs));
   input_ref_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_inputs));
-  row_.resize(static_cast<Eigen::Index>(p_full));
-  pair_row_.resize(static_cast<Eigen::Index>(p_pair));
   coef_.resize(static_cast<Eigen::Index>(p_full));
   pair_coef_.resize(static_cast<Eigen::Index>(p_pair));
   scratch_.resize(static_cast<Eigen::Index>(p_full + 1), static_cast<Eigen::Index>(p_full + 1));
@@ -190,25 +197,39 @@ void GrangerMonitor::absorb_sample(const double* residual) noexcept {
   sum_w2_ = lambda * lambda * sum_w2_ + 1.0;
   n_eq_ = sum_w_ * sum_w_ / sum_w2_;
 
-  // Shared part of the full regressor row: intercept and every input's lags.
-  const auto na = static_cast<Eigen::Index>(na_);
-  const auto nb = static_cast<Eigen::Index>(nb_);
-  row_[0] = 1.0;
-  pair_row_[0] = 1.0;
+  // Regressor rows written straight into each model's staged row:
+  // [1, AR lags of d~_j, lags of u_1, ..., u_m, target d~_j(k)].
+  const std::size_t nb = nb_;
   for (std::size_t j = 0; j < n_outputs_; ++j) {
-    const auto jj = static_cast<Eigen::Index>(j);
-    const auto first_channel = static_cast<Eigen::Index>(j * n_inputs_);
-    for (std::size_t i = 0; i < n_inputs_; ++i)
-      row_.segment(1 + na + static_cast<Eigen::Index>(i) * nb, nb) =
-          input_lags_.col(first_channel + static_cast<Eigen::Index>(i));
-    row_.segment(1, na) = residual_lags_.col(jj);
-    full_[j].update(row_.data(), residual[j]);
-    pair_row_.segment(1, na) = residual_lags_.col(jj);
-    for (std::size_t i = 0; i < n_inputs_; ++i) {
-      pair_row_.segment(1 + na, nb) = input_lags_.col(first_channel + static_cast<Eigen::Index>(i));
-      pairwise_[j * n_inputs_ + i].update(pair_row_.data(), residual[j]);
+    const double* ar = residual_lags_.col(static_cast<Eigen::Index>(j)).data();
+    const double* lags = input_lags_.col(static_cast<Eigen::Index>(j * n_inputs_)).data();  // nb per input
+    double* f = full_[j].staged_row();
+    f[0] = 1.0;
+    std::copy(ar, ar + na_, f + 1);
+    std::copy(lags, lags + n_inputs_ * nb, f + 1 + na_);
+    f[1 + na_ + n_inputs_ * nb] = residual[j];
+    for (std::size_t i = 1; i < n_inputs_; ++i) {
+      double* q = pairwise_[j * (n_inputs_ - 1) + i - 1].staged_row();
+      q[0] = 1.0;
+      std::copy(ar, ar + na_, q + 1);
+      std::copy(lags + i * nb, lags + (i + 1) * nb, q + 1 + na_);
+      q[1 + na_ + nb] = residual[j];
     }
   }
+  // Independent models in lockstep, a few at a time (all full models first,
+  // then the pairwise ones, so that sizes in a group are alike).
+  SqrtRls* group[kLockstep];
+  std::size_t in_group = 0;
+  const auto add = [&](SqrtRls& model) {
+    group[in_group++] = &model;
+    if (in_group == kLockstep) {
+      SqrtRls::update_staged(group, in_group);
+      in_group = 0;
+    }
+  };
+  for (SqrtRls& model : full_) add(model);
+  for (SqrtRls& model : pairwise_) add(model);
+  if (in_group > 0) SqrtRls::update_staged(group, in_group);
 }
 
 void GrangerMonitor::push_lags(const double* u, const double* residual) noexcept {
@@ -271,12 +292,12 @@ void GrangerMonitor::update_statistics() noexcept {
     bool any_channel = false;
     for (std::size_t i = 0; i < n_inputs_; ++i) {
       ChannelStats& c = channels_[j * n_inputs_ + i];
-      const double rss_without = full.rss_without(1 + na_ + i * nb_, nb_, scratch_);
+      const double rss_without = full.rss_without_wald(1 + na_ + i * nb_, nb_, scratch_);
       c.f_conditional = std::log(rss_without / rss_full);
       c.lr_conditional = scale_full * c.f_conditional;
 
-      const SqrtRls& pair = pairwise_[j * n_inputs_ + i];
-      const double rss_pair = pair.rss();
+      const SqrtRls& pair = pair_model(j, i);
+      const double rss_pair = pair.rss_prefix(p_pair);
       c.f_pairwise = std::log(pair.rss_prefix(1 + na_) / rss_pair);
       c.lr_pairwise = scale_pair * c.f_pairwise;
 
@@ -312,6 +333,12 @@ void GrangerMonitor::update_statistics() noexcept {
   }
 }
 
+const SqrtRls& GrangerMonitor::pair_model(std::size_t output, std::size_t input) const noexcept {
+  // Its first 1 + na + nb regressors are the pairwise model's.
+  if (input == 0) return full_[output];
+  return pairwise_[output * (n_inputs_ - 1) + input - 1];
+}
+
 template <typename Stats>
 void GrangerMonitor::update_hysteresis(Stats& s, double lr, double raise, double clear, bool& alarm) noexcept {
   if (lr > raise) {
@@ -335,7 +362,7 @@ void GrangerMonitor::full_coefficients(std::size_t output, Eigen::Ref<Eigen::Vec
 void GrangerMonitor::pairwise_ar_coefficients(std::size_t output, std::size_t input,
                                               Eigen::Ref<Eigen::VectorXd> out) const noexcept {
   // out: na values. Solve the pairwise model into scratch, copy the AR part.
-  pairwise_[output * n_inputs_ + input].solve_prefix(1 + na_ + nb_, pair_coef_);
+  pair_model(output, input).solve_prefix(1 + na_ + nb_, pair_coef_);
   out.head(static_cast<Eigen::Index>(na_)) = pair_coef_.segment(1, static_cast<Eigen::Index>(na_));
 }
 

@@ -14,7 +14,8 @@
 //   * the AR-only residual variance Sigma1 and the full-model variance,
 //   * the conditional Granger index of every input (all other inputs kept),
 //     F_c(u_i -> d~_j) = ln(RSS without u_i / RSS full),
-// and from one small factor per (output, input) pair, [1, AR, u_i],
+// and from one small factor per (output, input) pair, [1, AR, u_i] (for the
+// first input a prefix of the full model's factor, so no extra one),
 //   * the paper's pairwise index F(u_i -> d~_j) = ln(Sigma1 / Sigma2),
 //   * the AR coefficients the paper compares with N^-1: gamma(u_i -> d~_j).
 //
@@ -181,6 +182,9 @@ class GrangerMonitor {
   template <typename Stats>
   void update_hysteresis(Stats& s, double lr, double raise, double clear, bool& alarm) noexcept;
   void update_divergence(const double* residual) noexcept;
+  // The factor whose first 1 + na + nb regressors are [1, AR, u_i] of output
+  // j: the full model's for the first input, else a pairwise one.
+  const SqrtRls& pair_model(std::size_t output, std::size_t input) const noexcept;
 
   MonitorSettings settings_;
   std::size_t n_inputs_;
@@ -204,9 +208,7 @@ class GrangerMonitor {
                                    // u - input_ref_, so its zero state is at rest
 
   std::vector<SqrtRls> full_;      // one per output
-  std::vector<SqrtRls> pairwise_;  // output-major, one per (output, input)
-  Eigen::VectorXd row_;            // scratch regressor row (full)
-  Eigen::VectorXd pair_row_;       // scratch regressor row (pairwise)
+  std::vector<SqrtRls> pairwise_;  // output-major, one per (output, input > 0)
   Eigen::VectorXd coef_;           // scratch coefficients (full)
   mutable Eigen::VectorXd pair_coef_;  // scratch coefficients (pairwise)
   SqrtRls::Matrix scratch_;        // scratch for conditional RSS

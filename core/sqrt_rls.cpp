@@ -7,71 +7,154 @@
 namespace mpm {
 namespace {
 
-// Rotates rows a (pivot) and b so that b[first] becomes 0; columns
-// [first, end) of both rows are updated. Returns nothing; a[first] >= 0.
-inline void givens(double* a, double* b, std::size_t first, std::size_t end) noexcept {
-  const double x = a[first];
+// A kept-alive prior row every K samples: K as large as this (fewer
+// rotation chains), but a direction's prior may decay by at most kPriorDip
+// between two refreshes (p K samples apart).
+constexpr int kMaxPriorPeriod = 10;
+constexpr double kPriorDip = 0.25;
+
+struct Rotation {
+  double c = 1.0;
+  double s = 0.0;
+};
+
+// Rotates the pivot row a, scaled by `scale` first, against row b so that
+// b[first] becomes 0; columns [first, end) of both rows are updated and
+// a[first] stays >= 0. Returns the rotation (identity when b[first] == 0).
+inline Rotation rotate(double* __restrict a, double* __restrict b, std::size_t first, std::size_t end,
+                       double scale) noexcept {
+  const double x = scale * a[first];
   const double y = b[first];
-  if (y == 0.0) return;
-  const double r = std::sqrt(x * x + y * y);
-  const double c = x / r;
-  const double s = y / r;
-  a[first] = r;
+  if (y == 0.0) {
+    if (scale != 1.0)
+      for (std::size_t j = first; j < end; ++j) a[j] *= scale;
+    return {};
+  }
+  const double inv = 1.0 / std::sqrt(x * x + y * y);  // one division, two products
+  const double c = x * inv;
+  const double s = y * inv;
+  const double cs = c * scale;
+  const double ss = s * scale;
+  a[first] = x * c + y * s;
   b[first] = 0.0;
   for (std::size_t j = first + 1; j < end; ++j) {
     const double aj = a[j];
     const double bj = b[j];
-    a[j] = c * aj + s * bj;
-    b[j] = c * bj - s * aj;
+    a[j] = cs * aj + s * bj;
+    b[j] = c * bj - ss * aj;
   }
+  return {c, s};
+}
+
+// The same rotation on the inverse's rows: [a / scale; b] (columns [0, end)).
+inline void rotate_inverse(double* __restrict a, double* __restrict b, std::size_t end, Rotation rot,
+                           double inv_scale) noexcept {
+  const double ci = rot.c * inv_scale;
+  const double si = rot.s * inv_scale;
+  for (std::size_t j = 0; j < end; ++j) {
+    const double aj = a[j];
+    const double bj = b[j];
+    a[j] = ci * aj + rot.s * bj;
+    b[j] = rot.c * bj - si * aj;
+  }
+}
+
+int prior_period(std::size_t p, double lambda) {
+  if (lambda >= 1.0) return 1;
+  const double k = std::floor(std::log(kPriorDip) / (static_cast<double>(p) * std::log(lambda)));
+  return static_cast<int>(std::clamp(k, 1.0, static_cast<double>(kMaxPriorPeriod)));
 }
 
 }  // namespace
 
-SqrtRls::SqrtRls(std::size_t n_regressors, double forgetting, double regularization)
-    : p_(n_regressors), lambda_(forgetting), sqrt_lambda_(std::sqrt(forgetting)), delta_(regularization) {
+SqrtRls::SqrtRls(std::size_t n_regressors, double forgetting, double regularization, bool track_inverse)
+    : p_(n_regressors),
+      lambda_(forgetting),
+      sqrt_lambda_(std::sqrt(forgetting)),
+      inv_sqrt_lambda_(1.0 / std::sqrt(forgetting)),
+      delta_(regularization),
+      track_inverse_(track_inverse) {
   if (n_regressors == 0) throw std::invalid_argument("SqrtRls: need at least one regressor");
   if (!(forgetting > 0.0 && forgetting <= 1.0)) throw std::invalid_argument("SqrtRls: forgetting must be in (0, 1]");
   if (!(regularization > 0.0)) throw std::invalid_argument("SqrtRls: regularization must be > 0");
+  prior_period_ = prior_period(p_, lambda_);
+  prior_weight_ = std::sqrt(static_cast<double>(p_) * prior_period_ * (1.0 - lambda_) * delta_);
   const auto n = static_cast<Eigen::Index>(p_ + 1);
   r_.resize(n, n);
   work_.resize(n);
+  if (track_inverse_) {
+    linv_.resize(n - 1, n - 1);
+    work_inv_.resize(n - 1);
+  }
   reset();
 }
 
 void SqrtRls::reset() noexcept {
   r_.setZero();
   for (std::size_t i = 0; i < p_; ++i) r_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = std::sqrt(delta_);
+  if (track_inverse_) {
+    linv_.setZero();
+    for (std::size_t i = 0; i < p_; ++i)
+      linv_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = 1.0 / std::sqrt(delta_);
+  }
   next_prior_row_ = 0;
+  since_prior_ = 0;
 }
 
-void SqrtRls::absorb(std::size_t first_nonzero) noexcept {
+void SqrtRls::absorb(std::size_t first, double scale) noexcept {
+  if (track_inverse_) return absorb_with_inverse(first, scale);
   const std::size_t n = p_ + 1;
   double* w = work_.data();
-  for (std::size_t i = first_nonzero; i < n; ++i) {
-    if (w[i] == 0.0) continue;
-    givens(r_.row(static_cast<Eigen::Index>(i)).data(), w, i, n);
+  for (std::size_t i = first; i < n; ++i) rotate(r_.row(static_cast<Eigen::Index>(i)).data(), w, i, n, scale);
+}
+
+void SqrtRls::absorb_with_inverse(std::size_t first, double scale) noexcept {
+  std::fill(work_inv_.data(), work_inv_.data() + p_, 0.0);
+  for (std::size_t i = first; i <= p_; ++i) absorb_row(i, scale);
+}
+
+void SqrtRls::absorb_row(std::size_t i, double scale) noexcept {
+  const std::size_t n = p_ + 1;
+  const auto ii = static_cast<Eigen::Index>(i);
+  const Rotation rot = rotate(r_.row(ii).data(), work_.data(), i, n, scale);
+  if (track_inverse_ && i < p_) {
+    const double inv_scale = scale == sqrt_lambda_ ? inv_sqrt_lambda_ : 1.0 / scale;
+    rotate_inverse(linv_.row(ii).data(), work_inv_.data(), i + 1, rot, inv_scale);
   }
 }
 
 void SqrtRls::update(const double* x, double y) noexcept {
-  const std::size_t n = p_ + 1;
-  if (lambda_ < 1.0) {
-    for (std::size_t i = 0; i < n; ++i) {
-      double* row = r_.row(static_cast<Eigen::Index>(i)).data();
-      for (std::size_t j = i; j < n; ++j) row[j] *= sqrt_lambda_;
-    }
-    // Keep the prior alive: one unit row per sample, round robin, weighted so
-    // that p of them add (1 - lambda) * delta * p per direction (see header).
-    work_.setZero();
-    const std::size_t i = next_prior_row_;
-    work_[static_cast<Eigen::Index>(i)] = std::sqrt(static_cast<double>(p_) * (1.0 - lambda_) * delta_);
-    absorb(i);
-    next_prior_row_ = (next_prior_row_ + 1) % p_;
-  }
-  for (std::size_t j = 0; j < p_; ++j) work_[static_cast<Eigen::Index>(j)] = x[j];
+  std::copy(x, x + p_, work_.data());
   work_[static_cast<Eigen::Index>(p_)] = y;
-  absorb(0);
+  SqrtRls* self = this;
+  update_staged(&self, 1);
+}
+
+void SqrtRls::update_staged(SqrtRls* const* models, std::size_t count) noexcept {
+  // Rotation i of every model, then rotation i + 1: the models' chains of
+  // dependent square roots and divisions overlap in the pipeline.
+  std::size_t rows = 0;
+  for (std::size_t m = 0; m < count; ++m) {
+    SqrtRls& s = *models[m];
+    rows = std::max(rows, s.p_ + 1);
+    if (s.track_inverse_) std::fill(s.work_inv_.data(), s.work_inv_.data() + s.p_, 0.0);
+  }
+  for (std::size_t i = 0; i < rows; ++i)
+    for (std::size_t m = 0; m < count; ++m)
+      if (i <= models[m]->p_) models[m]->absorb_row(i, models[m]->sqrt_lambda_);  // forgetting folded in
+  for (std::size_t m = 0; m < count; ++m) models[m]->refresh_prior();
+}
+
+void SqrtRls::refresh_prior() noexcept {
+  if (lambda_ >= 1.0 || ++since_prior_ < prior_period_) return;
+  // Keep the prior alive: one unit row every K samples, round robin,
+  // weighted so that p of them add (1 - lambda) * delta * p K per direction.
+  since_prior_ = 0;
+  double* w = work_.data();
+  std::fill(w, w + p_ + 1, 0.0);
+  w[next_prior_row_] = prior_weight_;
+  absorb(next_prior_row_, 1.0);
+  next_prior_row_ = (next_prior_row_ + 1) % p_;
 }
 
 double SqrtRls::rss_prefix(std::size_t k) const noexcept {
@@ -88,7 +171,10 @@ double SqrtRls::rss_without(std::size_t first, std::size_t count, Matrix& scratc
   if (count == 0) return rss();
   if (first + count >= p_ + 1) return rss_prefix(first);  // dropping a trailing block
   // Rows [first, p] and the columns after the block, target last: upper
-  // trapezoidal with `count` extra subdiagonals; re-triangularise by Givens.
+  // trapezoidal with `count` extra subdiagonals. Re-triangularised by one
+  // Householder reflection per column (one square root per column instead of
+  // `count` dependent Givens rotations).
+  constexpr std::size_t kChunk = 64;
   const std::size_t rows = p_ + 1 - first;
   const std::size_t cols = p_ + 1 - first - count;
   for (std::size_t r = 0; r < rows; ++r) {
@@ -97,10 +183,38 @@ double SqrtRls::rss_without(std::size_t first, std::size_t count, Matrix& scratc
     for (std::size_t c = 0; c < cols; ++c) dst[c] = src[c];
   }
   for (std::size_t c = 0; c + 1 < cols; ++c) {
-    double* pivot = scratch.row(static_cast<Eigen::Index>(c)).data();
     const std::size_t last_row = std::min(rows - 1, c + count);
-    for (std::size_t r = c + 1; r <= last_row; ++r)
-      givens(pivot, scratch.row(static_cast<Eigen::Index>(r)).data(), c, cols);
+    double sigma = 0.0;  // squares below the diagonal
+    for (std::size_t r = c + 1; r <= last_row; ++r) {
+      const double v = scratch(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c));
+      sigma += v * v;
+    }
+    if (sigma == 0.0) continue;
+    double* pivot = scratch.row(static_cast<Eigen::Index>(c)).data();
+    const double alpha = pivot[c];
+    const double norm = std::sqrt(alpha * alpha + sigma);
+    const double v0 = alpha >= 0.0 ? alpha + norm : alpha - norm;  // v = [v0, x below]
+    const double tau = 2.0 / (v0 * v0 + sigma);
+    // In chunks of columns: proj = tau v^T A[c:, chunk], then A -= v proj.
+    for (std::size_t j0 = c + 1; j0 < cols; j0 += kChunk) {
+      const std::size_t j1 = std::min(cols, j0 + kChunk);
+      double proj[kChunk];
+      for (std::size_t j = j0; j < j1; ++j) proj[j - j0] = v0 * pivot[j];
+      for (std::size_t r = c + 1; r <= last_row; ++r) {
+        const double* row = scratch.row(static_cast<Eigen::Index>(r)).data();
+        const double vr = row[c];
+        for (std::size_t j = j0; j < j1; ++j) proj[j - j0] += vr * row[j];
+      }
+      for (std::size_t j = j0; j < j1; ++j) proj[j - j0] *= tau;
+      for (std::size_t j = j0; j < j1; ++j) pivot[j] -= v0 * proj[j - j0];
+      for (std::size_t r = c + 1; r <= last_row; ++r) {
+        double* row = scratch.row(static_cast<Eigen::Index>(r)).data();
+        const double vr = row[c];
+        for (std::size_t j = j0; j < j1; ++j) row[j] -= vr * proj[j - j0];
+      }
+    }
+    for (std::size_t r = c + 1; r <= last_row; ++r) scratch(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = 0.0;
+    pivot[c] = alpha >= 0.0 ? -norm : norm;
   }
   double s = 0.0;
   for (std::size_t r = cols - 1; r < rows; ++r) {
@@ -110,14 +224,69 @@ double SqrtRls::rss_without(std::size_t first, std::size_t count, Matrix& scratc
   return s;
 }
 
+double SqrtRls::rss_without_wald(std::size_t first, std::size_t count, Matrix& scratch) const noexcept {
+  if (count == 0) return rss();
+  if (first + count >= p_) return rss_prefix(first);  // trailing block: exact and free
+  if (!track_inverse_) return rss_without(first, count, scratch);
+  // With M = L[first:p, b] (L = R^-T lower triangular, so rows above `first`
+  // are zero in these columns) and z = R[first:p, target]:
+  //   [(R^T R)^-1]_bb = M^T M = S,  beta_b = M^T z = g,
+  //   RSS without b = RSS + g^T S^-1 g.
+  // S in scratch rows [0, count), g in row `count`.
+  double* g = scratch.row(static_cast<Eigen::Index>(count)).data();
+  std::fill(g, g + count, 0.0);
+  for (std::size_t a = 0; a < count; ++a) {
+    double* srow = scratch.row(static_cast<Eigen::Index>(a)).data();
+    std::fill(srow, srow + count, 0.0);
+  }
+  const auto target = static_cast<Eigen::Index>(p_);
+  for (std::size_t k = first; k < p_; ++k) {
+    const double* v = linv_.row(static_cast<Eigen::Index>(k)).data() + first;
+    const double z = r_(static_cast<Eigen::Index>(k), target);
+    const std::size_t len = std::min(count, k - first + 1);  // lower triangular
+    for (std::size_t a = 0; a < len; ++a) {
+      const double va = v[a];
+      g[a] += va * z;
+      double* srow = scratch.row(static_cast<Eigen::Index>(a)).data();
+      for (std::size_t c = 0; c <= a; ++c) srow[c] += va * v[c];
+    }
+  }
+  // Cholesky S = C C^T in place (lower triangle), forward solve C t = g;
+  // g^T S^-1 g = |t|^2.
+  double quad = 0.0;
+  for (std::size_t a = 0; a < count; ++a) {
+    double* ca = scratch.row(static_cast<Eigen::Index>(a)).data();
+    for (std::size_t b = 0; b <= a; ++b) {
+      const double* cb = scratch.row(static_cast<Eigen::Index>(b)).data();
+      double sum = ca[b];
+      for (std::size_t k = 0; k < b; ++k) sum -= ca[k] * cb[k];
+      if (b < a) {
+        ca[b] = sum / cb[b];
+      } else {
+        if (!(sum > 0.0)) return rss_without(first, count, scratch);  // not positive definite
+        ca[a] = std::sqrt(sum);
+      }
+    }
+    double t = g[a];
+    for (std::size_t k = 0; k < a; ++k) t -= ca[k] * g[k];
+    g[a] = t / ca[a];
+    quad += g[a] * g[a];
+  }
+  return rss() + quad;
+}
+
 void SqrtRls::solve_prefix(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const noexcept {
-  // Back substitution R[0:k, 0:k] beta = R[0:k, p].
+  // Back substitution R[0:k, 0:k] beta = R[0:k, p], column by column: the
+  // dependency chain per coefficient is one product and one update (the
+  // reciprocal of the diagonal does not wait for it), not a whole dot product.
   const auto last = static_cast<Eigen::Index>(p_);
-  for (std::size_t ii = k; ii-- > 0;) {
-    const auto i = static_cast<Eigen::Index>(ii);
-    double s = r_(i, last);
-    for (Eigen::Index j = i + 1; j < static_cast<Eigen::Index>(k); ++j) s -= r_(i, j) * out[j];
-    out[i] = s / r_(i, i);
+  double* beta = out.data();
+  for (std::size_t i = 0; i < k; ++i) beta[i] = r_(static_cast<Eigen::Index>(i), last);
+  for (std::size_t i = k; i-- > 0;) {
+    const auto ii = static_cast<Eigen::Index>(i);
+    const double b = beta[i] * (1.0 / r_(ii, ii));
+    beta[i] = b;
+    for (std::size_t r = 0; r < i; ++r) beta[r] -= r_(static_cast<Eigen::Index>(r), ii) * b;
   }
 }
 

@@ -3,23 +3,34 @@
 //
 // Keeps the upper-triangular factor R of the weighted augmented data matrix
 // [X y] (R^T R = sum_k lambda^(n-k) [x_k; y_k][x_k; y_k]^T + prior), updated
-// per sample by scaling with sqrt(lambda) and absorbing the new row with
-// Givens rotations: O(p^2), no allocation, and unlike the covariance (P-form)
-// recursion it stays equal to a batch QR fit after millions of samples.
+// per sample by absorbing the new row with Givens rotations, the forgetting
+// sqrt(lambda) folded into each rotation (no separate pass over R): O(p^2),
+// no allocation, and unlike the covariance (P-form) recursion it stays equal
+// to a batch QR fit after millions of samples.
 //
 // Because the target is the last column of R, the residual sum of squares of
 // every model made of the *first k* regressors is a partial sum of squares of
 // that column: nested models (AR-only inside AR + inputs) are free. A model
-// without an inner block of regressors is recovered by re-triangularising the
-// trailing part of R in scratch storage (rss_without).
+// without an inner block of regressors is recovered either by
+// re-triangularising the trailing part of R in scratch storage (rss_without,
+// O(p^2 count), no extra state), or, when the inverse factor is tracked, by
+// the Wald identity (rss_without_wald, O(p count^2)):
+//   RSS without block b = RSS + beta_b^T [(R^T R)^-1]_bb^-1 beta_b.
+// Tracking the inverse (track_inverse = true) carries L = R^-T (regressor
+// part, lower triangular) through the same rotations (inverse QR-RLS: if
+// Q^T [sqrt(lambda) R; x^T] = [R'; 0] then Q^T [L / sqrt(lambda); 0] =
+// [R'^-T; *]); it doubles the update's cost and pays off when many blocks
+// are tested.
 //
 // Poor excitation: with lambda < 1 the information in unexcited directions
 // decays and the covariance would blow up. A prior of weight `regularization`
 // per regressor is kept alive by re-adding, round robin, one scaled unit row
-// per sample (the amortised equivalent of adding (1 - lambda) * delta * I
-// every sample), so R^T R >= ~delta I at all times and the covariance stays
-// bounded. With lambda = 1 only the initial prior is added, so the fit equals
-// batch least squares with a ridge of `regularization` (negligible at 1e-9).
+// every K samples (the amortised equivalent of adding (1 - lambda) * delta * I
+// every sample), so R^T R >= ~delta I / 4 at all times and the covariance
+// stays bounded. K <= 10 is chosen so that a direction waits at most p * K
+// samples, during which its prior decays by no more than a factor of 4. With
+// lambda = 1 only the initial prior is added, so the fit equals batch least
+// squares with a ridge of `regularization` (negligible at 1e-9).
 #pragma once
 
 #include <cstddef>
@@ -35,10 +46,19 @@ class SqrtRls {
 
   SqrtRls() = default;
   // n_regressors >= 1, forgetting in (0, 1], regularization > 0.
-  SqrtRls(std::size_t n_regressors, double forgetting, double regularization = 1e-9);
+  // track_inverse: also carry R^-T for rss_without_wald.
+  SqrtRls(std::size_t n_regressors, double forgetting, double regularization = 1e-9,
+          bool track_inverse = false);
 
   // Real-time safe. x: n_regressors values, y: target.
   void update(const double* x, double y) noexcept;
+  // The same in two steps, for updating independent models together: write
+  // x then y into staged_row() (n_regressors + 1 values) of each model, then
+  // update_staged() interleaves their rotations, so the latencies of their
+  // square roots and divisions overlap. Each model ends exactly as if updated
+  // alone. Real-time safe.
+  double* staged_row() noexcept { return work_.data(); }
+  static void update_staged(SqrtRls* const* models, std::size_t count) noexcept;
 
   std::size_t n_regressors() const noexcept { return p_; }
   // Weighted residual sum of squares of the model of the first k regressors
@@ -48,11 +68,18 @@ class SqrtRls {
   // Weighted RSS of the model that leaves out regressors [first, first+count).
   // `scratch` must be at least (p+1) x (p+1); it is overwritten. Real-time safe.
   double rss_without(std::size_t first, std::size_t count, Matrix& scratch) const noexcept;
+  // The same by the Wald identity from the tracked inverse factor (requires
+  // tracks_inverse(); otherwise falls back to rss_without). Same scratch.
+  double rss_without_wald(std::size_t first, std::size_t count, Matrix& scratch) const noexcept;
+  bool tracks_inverse() const noexcept { return track_inverse_; }
   // Coefficients of the model of the first k regressors (back substitution).
   // out.size() >= k; writes out[0..k). Real-time safe.
   void solve_prefix(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const noexcept;
   // The factor, (p+1) x (p+1) upper triangular; last column = target.
   const Matrix& factor() const noexcept { return r_; }
+  // The tracked R^-T of the regressor part, p x p lower triangular (empty
+  // unless tracks_inverse()).
+  const Matrix& inverse_factor() const noexcept { return linv_; }
   // Back to the prior.
   void reset() noexcept;
 
@@ -60,11 +87,23 @@ class SqrtRls {
   std::size_t p_ = 0;
   double lambda_ = 1.0;
   double sqrt_lambda_ = 1.0;
+  double inv_sqrt_lambda_ = 1.0;
   double delta_ = 1e-9;
+  bool track_inverse_ = false;
+  int prior_period_ = 1;        // K: samples between kept-alive prior rows
+  int since_prior_ = 0;
+  double prior_weight_ = 0.0;   // sqrt(p K (1 - lambda) delta)
   std::size_t next_prior_row_ = 0;
   Matrix r_;                // (p+1) x (p+1)
+  Matrix linv_;             // p x p lower triangular R^-T, or empty
   Eigen::VectorXd work_;    // row being absorbed, size p+1
-  void absorb(std::size_t first_nonzero) noexcept;  // absorbs work_ into r_
+  Eigen::VectorXd work_inv_;  // its counterpart in the inverse, size p
+  // Absorbs work_ into r_ (rows >= first), pivot rows scaled by `scale`
+  // first (scale != 1 needs first == 0).
+  void absorb(std::size_t first, double scale) noexcept;
+  void absorb_with_inverse(std::size_t first, double scale) noexcept;
+  void absorb_row(std::size_t i, double scale) noexcept;  // rotation i only
+  void refresh_prior() noexcept;  // the kept-alive prior row, when due
 };
 
 }  // namespace mpm

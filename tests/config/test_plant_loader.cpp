@@ -90,8 +90,8 @@ TEST(ExamplePlants, WoodBerryDiscreteHasThePaperModel) {
   EXPECT_EQ(plant.noise[1]->tf.den, (std::vector<double>{1.0, -0.9}));
   EXPECT_EQ(plant.noise[1]->variance, 1.0);
   ASSERT_TRUE(plant.operating_point.has_value());
-  EXPECT_EQ(plant.operating_point->inputs, (std::vector<double>{0.0, 0.0}));
-  EXPECT_EQ(plant.operating_point->outputs, (std::vector<double>{0.0, 0.0}));
+  EXPECT_EQ(plant.operating_point->inputs, (std::vector<double>{15.0, 12.0}));
+  EXPECT_EQ(plant.operating_point->outputs, (std::vector<double>{90.0, 5.0}));
 }
 
 // Leading zero coefficients of num are pure delay: compare in a form where

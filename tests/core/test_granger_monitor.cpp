@@ -8,6 +8,7 @@
 
 #include "core/granger_monitor.hpp"
 #include "core/noise_filter.hpp"
+#include "core/sqrt_rls.hpp"
 #include "core/transfer_function.hpp"
 #include "support/alloc_counter.hpp"
 
@@ -206,6 +207,60 @@ TEST(GrangerMonitor, UpdateAllocatesNothing) {
   // Every sample is used except the lag fill at the start (10), the NaN
   // sample and the lag refill after it (10).
   EXPECT_EQ(m.counters().used, 100u + 100'000u - 10u - 1u - 10u);
+}
+
+// The statistics equal independent least-squares fits of the same regressor
+// rows: the pairwise models (the first input's is a prefix of the full
+// model's factor) and the conditional RSS (re-triangularisation below 4
+// inputs, the Wald identity on the tracked inverse from 4 on).
+void expect_matches_reference_fits(std::size_t m) {
+  MonitorSettings s;
+  s.ar_order = 3;
+  s.input_order = 4;
+  s.forgetting = 1.0;
+  const std::size_t na = 3, nb = 4, p_full = 1 + na + m * nb, p_pair = 1 + na + nb;
+  GrangerMonitor monitor(m, 1, s);
+  SqrtRls full(p_full, 1.0, 1e-9);
+  std::vector<SqrtRls> pair(m, SqrtRls(p_pair, 1.0, 1e-9));
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::vector<std::vector<double>> u_hist(m);
+  std::vector<double> d_hist;
+  std::vector<double> u(m), x(p_full), xp(p_pair);
+  for (std::size_t k = 0; k < 3000; ++k) {
+    for (std::size_t i = 0; i < m; ++i) u[i] = n(rng) + (i > 0 ? 0.5 * u[0] : 0.0);
+    double d = 0.3 * n(rng) + (k > 0 ? 0.5 * d_hist[k - 1] : 0.0) + (k > 1 ? 0.4 * u_hist[0][k - 2] : 0.0);
+    ASSERT_EQ(monitor.update(u.data(), &d), k >= 4 ? SampleStatus::kUsed : SampleStatus::kWarmingUp);
+    for (std::size_t i = 0; i < m; ++i) u_hist[i].push_back(u[i]);
+    d_hist.push_back(d);
+    if (k < 4) continue;
+    // Regressors: intercept, d(k-1..k-na), u_i(k-1..k-nb) about u_i(0).
+    x[0] = xp[0] = 1.0;
+    for (std::size_t l = 1; l <= na; ++l) x[l] = xp[l] = d_hist[k - l];
+    for (std::size_t i = 0; i < m; ++i)
+      for (std::size_t l = 1; l <= nb; ++l) x[na + i * nb + l] = u_hist[i][k - l] - u_hist[i][0];
+    full.update(x.data(), d);
+    for (std::size_t i = 0; i < m; ++i) {
+      std::copy(x.begin() + static_cast<long>(1 + na + i * nb), x.begin() + static_cast<long>(1 + na + (i + 1) * nb),
+                xp.begin() + static_cast<long>(1 + na));
+      pair[i].update(xp.data(), d);
+    }
+  }
+  SqrtRls::Matrix scratch(static_cast<Eigen::Index>(p_full + 1), static_cast<Eigen::Index>(p_full + 1));
+  const auto close = [](double a, double ref) { return std::abs(a - ref) <= 1e-8 * std::abs(ref) + 1e-12; };
+  for (std::size_t i = 0; i < m; ++i) {
+    const double f_cond = std::log(full.rss_without(1 + na + i * nb, nb, scratch) / full.rss());
+    const double f_pair = std::log(pair[i].rss_prefix(1 + na) / pair[i].rss());
+    EXPECT_PRED2(close, monitor.channel(0, i).f_conditional, f_cond) << "m=" << m << " input " << i;
+    EXPECT_PRED2(close, monitor.channel(0, i).f_pairwise, f_pair) << "m=" << m << " input " << i;
+  }
+  EXPECT_GT(monitor.channel(0, 0).lr_conditional, monitor.raise_threshold());  // the planted link is seen
+}
+
+TEST(GrangerMonitor, StatisticsEqualReferenceFits) {
+  expect_matches_reference_fits(2);  // re-triangularisation
+  expect_matches_reference_fits(4);  // Wald identity
+  expect_matches_reference_fits(6);
 }
 
 TEST(MonitorSettings, ValidateNamesTheField) {
