@@ -41,7 +41,7 @@ void read_monitor(const YamlReader& r, const Field& root, DaemonConfig& c) {
   const Field m = r.child(root, "monitor");
   if (!m.present() || m.node.IsNull()) return;
   r.check_keys(m, {"ar_order", "input_order", "forgetting", "false_alarm", "clear_ratio", "raise_after",
-                   "clear_after", "warmup", "gamma_lambda", "settle_samples"});
+                   "clear_after", "warmup", "gamma_lambda", "input_pole", "regressors", "settle_samples"});
   MonitorSettings& s = c.monitor;
   read(r, m, "ar_order", s.ar_order);
   read(r, m, "input_order", s.input_order);
@@ -52,12 +52,33 @@ void read_monitor(const YamlReader& r, const Field& root, DaemonConfig& c) {
   read(r, m, "clear_after", s.clear_after);
   read(r, m, "warmup", s.warmup);
   read(r, m, "gamma_lambda", s.gamma_lambda);
+  const Field pole = r.child(m, "input_pole");
+  if (pole.present() && pole.node.IsScalar() && pole.node.Scalar() == "auto") {
+    c.input_pole_auto = true;
+  } else {
+    read(r, m, "input_pole", s.input_pole);
+  }
+  const Field regressors = r.child(m, "regressors");
+  if (regressors.present()) {
+    const std::string kind = r.name(regressors);
+    if (kind != "model_filtered" && kind != "plain_lags")
+      r.fail(regressors, "expected model_filtered or plain_lags, got \"" + kind + "\"");
+    c.plain_lags = kind == "plain_lags";
+  }
   const Field settle = r.child(m, "settle_samples");
   if (settle.present() && !(settle.node.IsScalar() && settle.node.Scalar() == "auto")) {
     c.settle_samples = r.integer(settle);
     if (c.settle_samples < 0) r.fail(settle, "expected \"auto\" or a number of samples >= 0");
   }
-  if (const std::string problem = s.validate(); !problem.empty()) r.fail(m, problem);
+  // validate() names the field first ("forgetting must be in ..."): point at
+  // that key when the file has it.
+  if (const std::string problem = s.validate(); !problem.empty()) {
+    for (const auto& kv : m.node) {
+      const std::string key = kv.first.Scalar();
+      if (problem.rfind(key + " ", 0) == 0) r.fail(r.child(m, key), problem);
+    }
+    r.fail(m, problem);
+  }
 }
 
 void read_lcm(const YamlReader& r, const Field& t, transport::LcmSettings& lcm) {

@@ -8,7 +8,8 @@
 //   plant: wood-berry.yaml          # relative to this file's folder
 //   monitor: {ar_order: 10, input_order: 10, forgetting: 0.999, false_alarm: 1e-3,
 //             clear_ratio: 0.5, raise_after: 20, clear_after: 100, warmup: 0,
-//             gamma_lambda: 0.1, settle_samples: auto}
+//             gamma_lambda: 0.1, input_pole: 0, regressors: model_filtered,
+//             settle_samples: auto}
 //   transport:
 //     kind: lcm                     # lcm | dds
 //     lcm: {url: "udpm://239.255.76.67:7667?ttl=0", sample_channel: MPM_SAMPLE,
@@ -32,6 +33,8 @@ struct DaemonConfig {
   std::string controller_id;   // samples of other controllers are ignored
   std::string plant_path;      // resolved against the config file's folder
   MonitorSettings monitor;
+  bool input_pole_auto = false;  // input_pole: auto = the plant's dominant pole
+  bool plain_lags = false;     // regressors: plain_lags (the paper's) or model_filtered
   int settle_samples = -1;     // samples skipped after the model starts; -1 = automatic
   transport::Settings transport;
   double status_period = 1.0;  // seconds between status messages

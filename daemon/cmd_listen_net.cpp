@@ -63,7 +63,7 @@ int listen(transport::Transport& t, Filter& filter, bool samples, double timeout
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   while (!g_stop && !filter.done()) {
     if (timeout_s > 0 && std::chrono::steady_clock::now() >= deadline) break;
-    if (t.handle(std::chrono::milliseconds(100)) < 0) {
+    if (t.handle(std::chrono::milliseconds(100)) < 0 && !g_stop) {
       std::fprintf(stderr, "mpm listen: the transport failed\n");
       return 1;
     }

@@ -40,10 +40,11 @@ inline NetOptions read(const Args& args) {
   if (auto path = args.get("config")) {
     o.daemon = config::load_daemon_config(*path);
     o.transport = o.daemon->transport;
-  } else if (!args.get("transport")) {
-    throw UsageError("--transport lcm|dds (or --config FILE) is required");
   }
-  if (auto kind = args.get("transport"); kind && !transport::parse_kind(*kind, o.transport.kind)) {
+  // `--publish lcm|dds` is the same as --transport where a command takes it.
+  const auto kind = args.get("transport") ? args.get("transport") : args.get("publish");
+  if (!kind && !o.daemon) throw UsageError("--transport lcm|dds (or --config FILE) is required");
+  if (kind && !transport::parse_kind(*kind, o.transport.kind)) {
     throw UsageError("--transport: expected lcm or dds, got '" + *kind + "'");
   }
   if (auto url = args.get("lcm-url")) o.transport.lcm.url = *url;

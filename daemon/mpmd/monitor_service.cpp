@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "core/noise_filter.hpp"
+#include "daemon/offline.hpp"
 #include "daemon/mpmd/log.hpp"
 
 namespace mpm {
@@ -23,19 +23,16 @@ constexpr std::int64_t kResettleGap = 5;
 // model's time is lost anyway and the settle restart covers it.
 constexpr std::int64_t kMaxGapFill = 10000;
 
-std::vector<std::optional<std::vector<double>>> noise_ar(const PlantModel& plant, int order) {
-  std::vector<std::optional<std::vector<double>>> out(plant.n_outputs());
-  for (std::size_t j = 0; j < plant.n_outputs() && j < plant.noise.size(); ++j) {
-    if (plant.noise[j]) out[j] = inverse_noise_ar_coefficients(plant.noise[j]->tf, order);
-  }
-  return out;
-}
-
 bool all_finite(const std::vector<double>& v) noexcept {
   for (const double x : v) {
     if (!std::isfinite(x)) return false;
   }
   return true;
+}
+
+std::int64_t unix_micros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
 }
 
 std::chrono::duration<double> seconds(double s) { return std::chrono::duration<double>(s); }
@@ -58,7 +55,10 @@ MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& s
     : plant_(plant),
       settings_(settings),
       on_alarm_(std::move(on_alarm)),
-      monitor_(plant.n_inputs(), plant.n_outputs(), settings.monitor, noise_ar(plant, settings.monitor.ar_order)),
+      // The same monitor as `mpm monitor` builds offline (daemon/offline.hpp).
+      monitor_(plant.n_inputs(), plant.n_outputs(), settings.monitor, noise_ar(plant, settings.monitor.ar_order),
+               reference_variances(plant),
+               settings.plain_lags ? std::vector<std::optional<DiscreteTf>>{} : channel_models(plant)),
       residual_(plant.n_outputs(), 0.0),
       nan_u_(plant.n_inputs(), kNaN),
       nan_y_(plant.n_outputs(), kNaN),
@@ -162,15 +162,41 @@ void MonitorService::check_alarms(const msg::Sample& s) {
   }
 }
 
-void MonitorService::publish_alarm(std::size_t output, std::size_t input, const msg::Sample& s) {
-  const ChannelStats& c = monitor_.channel(output, input);
+void MonitorService::fill_alarm_header(std::size_t output, std::size_t input, std::int64_t utime, std::int64_t seq) {
   alarm_.controller_id = settings_.controller_id;
-  alarm_.utime = s.utime;
-  alarm_.sample_sequence = s.seq;
+  // The sample's own time; the time of receipt when the publisher sent none.
+  alarm_.utime = utime != 0 ? utime : unix_micros();
+  alarm_.sample_sequence = seq;
   alarm_.output = plant_.outputs[output];
   alarm_.input = plant_.inputs[input];
   alarm_.output_index = static_cast<std::int32_t>(output);
   alarm_.input_index = static_cast<std::int32_t>(input);
+}
+
+void MonitorService::retire(const std::string& reason) {
+  const std::size_t n_in = plant_.n_inputs();
+  for (std::size_t j = 0; j < plant_.n_outputs(); ++j) {
+    for (std::size_t i = 0; i < n_in; ++i) {
+      if (!alarm_state_[j * n_in + i]) continue;
+      alarm_state_[j * n_in + i] = 0;
+      const ChannelStats& c = monitor_.channel(j, i);
+      fill_alarm_header(j, i, 0, tracker_.last());
+      alarm_.raised = false;
+      alarm_.f = c.f_conditional;
+      alarm_.p_value = monitor_.p_value(c.lr_conditional);
+      alarm_.gamma = c.gamma;
+      alarm_.physics.clear();
+      alarm_.text = "cleared: " + alarm_.input + " -> " + alarm_.output + " no longer watched by this monitor (" +
+                    reason + ")";
+      log::write(log::Level::kNotice, "controller '%s': %s", settings_.controller_id.c_str(), alarm_.text.c_str());
+      if (on_alarm_) on_alarm_(alarm_);
+    }
+  }
+}
+
+void MonitorService::publish_alarm(std::size_t output, std::size_t input, const msg::Sample& s) {
+  const ChannelStats& c = monitor_.channel(output, input);
+  fill_alarm_header(output, input, s.utime, s.seq);
   alarm_.raised = c.alarm;
   alarm_.f = c.f_conditional;
   alarm_.p_value = monitor_.p_value(c.lr_conditional);

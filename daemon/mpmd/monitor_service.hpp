@@ -35,6 +35,9 @@ namespace mpm {
 struct ServiceSettings {
   std::string controller_id;
   MonitorSettings monitor;
+  // Regress on plain input lags (the paper's) instead of lags of the input
+  // filtered through the nominal channel (what `mpm monitor` does by default).
+  bool plain_lags = false;
   // Samples skipped after the nominal model starts (or restarts after a long
   // gap) while its start-up transient decays; -1 = the plant's settling time.
   int settle_samples = -1;
@@ -71,6 +74,11 @@ class MonitorService {
   void add_dropped(std::uint64_t count, Clock::time_point now);
   void add_receive_errors(std::uint64_t count, Clock::time_point now);
 
+  // Publishes a "cleared" alarm for every channel raised now, saying why (the
+  // service is being replaced, e.g. by a reload with new settings), so that
+  // operators do not keep seeing alarms nobody will clear.
+  void retire(const std::string& reason);
+
   // Current statistics and counters. Reuses `out`'s storage.
   void fill_status(msg::Status& out, std::int64_t utime, std::int64_t uptime_ms) const;
 
@@ -87,6 +95,7 @@ class MonitorService {
   void step(const double* u, const double* y, const double* sim_y) noexcept;
   void check_alarms(const msg::Sample& s);
   void publish_alarm(std::size_t output, std::size_t input, const msg::Sample& s);
+  void fill_alarm_header(std::size_t output, std::size_t input, std::int64_t utime, std::int64_t seq);
   void report_sequence(const SequenceTracker::Result& r, const msg::Sample& s, Clock::time_point now);
   void report_malformed(const msg::Sample& s, Clock::time_point now);
 

@@ -126,6 +126,7 @@ void ServiceLoop::apply_reload() {
       notifier_.ready("reload failed; running the previous configuration");
       return;
     }
+    service_->retire("reloaded with new settings");
     service_ = std::move(service);
     log::write(log::Level::kNotice, "reloaded %s: new monitor settings, statistics start again",
                config_path_.c_str());

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "config/plant_loader.hpp"
+#include "core/mimo_model.hpp"
 #include "daemon/mpmd/log.hpp"
 
 namespace mpm {
@@ -24,7 +25,8 @@ std::string fingerprint(const config::DaemonConfig& c) {
   f << c.controller_id << '\n'
     << m.ar_order << ' ' << m.input_order << ' ' << m.forgetting << ' ' << m.false_alarm << ' ' << m.clear_ratio
     << ' ' << m.raise_after << ' ' << m.clear_after << ' ' << m.warmup << ' ' << m.gamma_lambda << ' '
-    << c.settle_samples << ' ' << c.log_interval << '\n'
+    << m.input_pole << ' ' << c.input_pole_auto << ' ' << c.plain_lags << ' ' << c.settle_samples << ' '
+    << c.log_interval << '\n'
     << c.plant_path << '\n'
     << read_text(c.plant_path);
   return f.str();
@@ -52,6 +54,8 @@ std::unique_ptr<MonitorService> make_service(const LoadedConfig& loaded, Monitor
   ServiceSettings settings;
   settings.controller_id = loaded.config.controller_id;
   settings.monitor = loaded.config.monitor;
+  if (loaded.config.input_pole_auto) settings.monitor.input_pole = dominant_pole(loaded.plant);
+  settings.plain_lags = loaded.config.plain_lags;
   settings.settle_samples = loaded.config.settle_samples;
   settings.log_interval = loaded.config.log_interval;
   try {

@@ -1,0 +1,182 @@
+// LCM adapter. Each channel carries one type; received bytes are decoded into
+// a member message object and converted into a member plain message, both
+// reused, so steady-state receiving does not allocate. Publishing encodes
+// into a reused buffer under a mutex (publish may come from any thread).
+//
+// It talks to LCM's C API: the C++ wrapper's member-function subscriptions
+// (lcm-cpp-impl.hpp, LCM 1.3.1) hand the callback a wrong object when built
+// with -fsanitize=undefined, and the C API is all we need.
+#include "transport/lcm_transport.hpp"
+
+#include <poll.h>
+
+#include <cerrno>
+
+#include <atomic>
+#include <mutex>
+#include <vector>
+
+#include <lcm/lcm.h>
+
+#include "transport/lcm_codec.hpp"
+
+namespace mpm::transport {
+
+namespace {
+
+// LCM's own per-subscription queue (default 30 messages) sits in front of
+// ours; a deeper one absorbs bursts while the receiver thread is descheduled.
+constexpr int kLcmQueueCapacity = 1000;
+constexpr int kMaxBatch = 256;
+
+class LcmTransport final : public Transport {
+ public:
+  explicit LcmTransport(const LcmSettings& settings)
+      : settings_(settings), lcm_(lcm_create(settings.url.c_str())) {}
+  ~LcmTransport() override {
+    if (lcm_ != nullptr) lcm_destroy(lcm_);
+  }
+  LcmTransport(const LcmTransport&) = delete;
+  LcmTransport& operator=(const LcmTransport&) = delete;
+
+  bool good() const { return lcm_ != nullptr; }
+
+  bool subscribe_samples(SampleHandler handler) override {
+    on_sample_ = std::move(handler);
+    return subscribe(settings_.sample_channel, routes_[0], &LcmTransport::receive_sample);
+  }
+  bool subscribe_alarms(AlarmHandler handler) override {
+    on_alarm_ = std::move(handler);
+    return subscribe(settings_.alarm_channel, routes_[1], &LcmTransport::receive_alarm);
+  }
+  bool subscribe_status(StatusHandler handler) override {
+    on_status_ = std::move(handler);
+    return subscribe(settings_.status_channel, routes_[2], &LcmTransport::receive_status);
+  }
+
+  bool publish(const msg::Sample& sample) override {
+    std::lock_guard lock(publish_mutex_);
+    lcm_codec::to_wire(sample, tx_sample_);
+    return send(settings_.sample_channel, tx_sample_);
+  }
+  bool publish(const msg::Alarm& alarm) override {
+    std::lock_guard lock(publish_mutex_);
+    lcm_codec::to_wire(alarm, tx_alarm_);
+    return send(settings_.alarm_channel, tx_alarm_);
+  }
+  bool publish(const msg::Status& status) override {
+    std::lock_guard lock(publish_mutex_);
+    lcm_codec::to_wire(status, tx_status_);
+    return send(settings_.status_channel, tx_status_);
+  }
+
+  // lcm's handleTimeout dispatches one message; drain what is already waiting
+  // on the descriptor too, up to a batch.
+  int handle(std::chrono::milliseconds timeout) override {
+    const int rc = lcm_handle_timeout(lcm_, static_cast<int>(timeout.count()));
+    if (rc < 0) return errno == EINTR ? 0 : -1;  // a signal is not a failure
+    if (rc == 0) return 0;
+    int handled = 1;
+    while (handled < kMaxBatch && readable_now()) {
+      if (lcm_handle(lcm_) != 0) return -1;
+      ++handled;
+    }
+    return handled;
+  }
+
+  int fd() const override { return lcm_get_fileno(lcm_); }
+  std::uint64_t receive_errors() const override { return receive_errors_; }
+  std::string describe() const override { return "lcm " + settings_.url; }
+
+ private:
+  using Receive = void (LcmTransport::*)(const lcm_recv_buf_t*);
+  // What LCM's C callback gets as user data: this transport and the member
+  // that decodes the channel's type.
+  struct Route {
+    LcmTransport* self = nullptr;
+    Receive receive = nullptr;
+  };
+  static void dispatch(const lcm_recv_buf_t* rbuf, const char*, void* user) {
+    const Route* r = static_cast<const Route*>(user);
+    (r->self->*r->receive)(rbuf);
+  }
+
+  bool subscribe(const std::string& channel, Route& route, Receive receive) {
+    route = Route{this, receive};
+    lcm_subscription_t* sub = lcm_subscribe(lcm_, channel.c_str(), &LcmTransport::dispatch, &route);
+    if (sub == nullptr) return false;
+    lcm_subscription_set_queue_capacity(sub, kLcmQueueCapacity);
+    return true;
+  }
+
+  bool readable_now() {
+    pollfd p{lcm_get_fileno(lcm_), POLLIN, 0};
+    return ::poll(&p, 1, 0) > 0 && (p.revents & POLLIN);
+  }
+
+  template <typename Wire>
+  bool send(const std::string& channel, const Wire& wire) {
+    const int size = wire.getEncodedSize();
+    if (size < 0) return false;
+    tx_buffer_.resize(static_cast<std::size_t>(size));
+    if (wire.encode(tx_buffer_.data(), 0, size) != size) return false;
+    return lcm_publish(lcm_, channel.c_str(), tx_buffer_.data(), static_cast<unsigned>(size)) == 0;
+  }
+
+  // Decodes into `wire` then `plain`; a message that fails either step is
+  // counted and dropped (bad bytes must never stop the receiver).
+  template <typename Wire, typename Plain, typename Handler>
+  void receive(const lcm_recv_buf_t* rbuf, Wire& wire, Plain& plain, const Handler& handler) {
+    bool ok = false;
+    try {
+      ok = wire.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) >= 0 &&
+           lcm_codec::from_wire(wire, plain);
+    } catch (const std::exception&) {  // a hostile length can make a vector throw
+      ok = false;
+    }
+    if (!ok) {
+      ++receive_errors_;
+      return;
+    }
+    if (handler) handler(plain);
+  }
+
+  void receive_sample(const lcm_recv_buf_t* rbuf) { receive(rbuf, rx_sample_, sample_, on_sample_); }
+  void receive_alarm(const lcm_recv_buf_t* rbuf) { receive(rbuf, rx_alarm_, alarm_, on_alarm_); }
+  void receive_status(const lcm_recv_buf_t* rbuf) { receive(rbuf, rx_status_, status_, on_status_); }
+
+  LcmSettings settings_;
+  lcm_t* lcm_;
+  Route routes_[3];  // samples, alarms, status: addresses handed to LCM
+
+  SampleHandler on_sample_;
+  AlarmHandler on_alarm_;
+  StatusHandler on_status_;
+  mpm_lcm::sample_t rx_sample_;
+  mpm_lcm::alarm_t rx_alarm_;
+  mpm_lcm::status_t rx_status_;
+  msg::Sample sample_;
+  msg::Alarm alarm_;
+  msg::Status status_;
+  std::atomic<std::uint64_t> receive_errors_{0};
+
+  std::mutex publish_mutex_;
+  mpm_lcm::sample_t tx_sample_;
+  mpm_lcm::alarm_t tx_alarm_;
+  mpm_lcm::status_t tx_status_;
+  std::vector<std::uint8_t> tx_buffer_;
+};
+
+}  // namespace
+
+std::unique_ptr<Transport> make_lcm_transport(const LcmSettings& settings, std::string& error) {
+  auto transport = std::make_unique<LcmTransport>(settings);
+  if (!transport->good()) {
+    error = "LCM: cannot open '" + settings.url +
+            "' (a udpm:// URL needs a multicast route, e.g. 'ip route add 224.0.0.0/4 dev lo')";
+    return nullptr;
+  }
+  return transport;
+}
+
+}  // namespace mpm::transport

@@ -1,0 +1,45 @@
+// Which transport to use and how it is named on the wire. Plain data with the
+// defaults of the README, so config files only say what differs.
+#pragma once
+
+#include <string>
+
+namespace mpm::transport {
+
+enum class Kind { kLcm, kDds };
+
+struct LcmSettings {
+  // Default LCM URL: multicast with ttl=0 keeps the traffic on this host.
+  std::string url = "udpm://239.255.76.67:7667?ttl=0";
+  std::string sample_channel = "MPM_SAMPLE";
+  std::string alarm_channel = "MPM_ALARM";
+  std::string status_channel = "MPM_STATUS";
+};
+
+struct DdsSettings {
+  int domain = 0;           // DDS domain id, 0..230
+  // Cyclone DDS configuration: a file path, a file:// URI or inline XML.
+  // Empty = Cyclone's own default (CYCLONEDDS_URI if set).
+  std::string config;
+  std::string sample_topic = "mpm_sample";
+  std::string alarm_topic = "mpm_alarm";
+  std::string status_topic = "mpm_status";
+  int sample_history = 64;  // KEEP_LAST depth of sample writer and reader
+};
+
+struct Settings {
+  Kind kind = Kind::kLcm;
+  LcmSettings lcm;
+  DdsSettings dds;
+};
+
+inline const char* to_string(Kind kind) noexcept { return kind == Kind::kDds ? "dds" : "lcm"; }
+
+// "lcm" / "dds"; false (kind unchanged) for anything else.
+inline bool parse_kind(const std::string& text, Kind& kind) noexcept {
+  if (text != "lcm" && text != "dds") return false;
+  kind = text == "dds" ? Kind::kDds : Kind::kLcm;
+  return true;
+}
+
+}  // namespace mpm::transport
