@@ -1,6 +1,7 @@
 #include "bench/flops.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "bench/cpu_clock.hpp"
 
@@ -11,65 +12,172 @@
 namespace mpm::bench {
 namespace {
 
-// givens(a, b, first, end): x*x + y*y, sqrt, two divisions, then 4 mul +
-// 2 add for each of the `tail` columns after `first`.
-double givens_flops(std::size_t tail) { return 6.0 + 6.0 * static_cast<double>(tail); }
+// Mirrors of constants private to the core (keep in step with it).
+constexpr int kMaxPriorPeriod = 10;        // core/sqrt_rls.cpp
+constexpr double kPriorDip = 0.25;         // core/sqrt_rls.cpp
+constexpr std::size_t kWaldMinInputs = 4;  // core/granger_monitor.cpp
 
-// absorb(first) on an augmented row of n = p + 1: one rotation per row i in
-// [first, n), each over the columns after i.
-double absorb_flops(std::size_t first, std::size_t n) {
+double d(std::size_t n) { return static_cast<double>(n); }
+
+// rotate(a, b, first, end, scale): x = scale a[first], 1 / sqrt(x^2 + y^2)
+// (mul, mul, add, sqrt, div), c, s, c scale, s scale (4 mul), the new pivot
+// x c + y s (3): 13; then 2 x (2 mul + 1 add) for each of the `tail` columns
+// after `first`. The scale's products are done even when scale = 1.
+double rotation_flops(std::size_t tail) { return 13.0 + 6.0 * d(tail); }
+
+// rotate_inverse on columns [0, width): c / scale and s / scale as products
+// (2), then 6 per column; `inverse_division` when the scale's reciprocal is
+// not the cached 1 / sqrt(lambda) (the prior row, scale 1: 1.0 / scale).
+double inverse_rotation_flops(std::size_t width, bool inverse_division) {
+  return 2.0 + 6.0 * d(width) + (inverse_division ? 1.0 : 0.0);
+}
+
+// absorb(first, scale) of a row of p regressors + target into R: rotations
+// i = first..p over the columns after i; with the inverse, rotations
+// i = first..p-1 also on R^-T's row i (columns [0, i]).
+double absorb_flops(std::size_t first, std::size_t p, bool track_inverse, bool inverse_division) {
   double f = 0.0;
-  for (std::size_t i = first; i < n; ++i) f += givens_flops(n - 1 - i);
+  for (std::size_t i = first; i <= p; ++i) {
+    f += rotation_flops(p - i);
+    if (track_inverse && i < p) f += inverse_rotation_flops(i + 1, inverse_division);
+  }
   return f;
 }
 
+// Sum of squares of `terms` values: a multiply and an add each.
+double sum_of_squares_flops(std::size_t terms) { return 2.0 * d(terms); }
+
+// SqrtRls::rss_prefix(k) of a model with p regressors: rows k..p.
+double rss_prefix_flops(std::size_t p, std::size_t k) { return sum_of_squares_flops(p + 1 - k); }
+
 }  // namespace
 
-double sqrt_rls_update_flops(std::size_t p, bool forgetting) {
-  const std::size_t n = p + 1;
-  double f = absorb_flops(0, n);  // the data row
-  if (forgetting) {
-    f += static_cast<double>(n * (n + 1) / 2);  // scale R by sqrt(lambda)
+int prior_refresh_period(std::size_t p, double lambda) {
+  if (lambda >= 1.0) return 1;
+  const double k = std::floor(std::log(kPriorDip) / (d(p) * std::log(lambda)));
+  return static_cast<int>(std::clamp(k, 1.0, static_cast<double>(kMaxPriorPeriod)));
+}
+
+double sqrt_rls_update_flops(std::size_t p, double lambda, bool track_inverse) {
+  double f = absorb_flops(0, p, track_inverse, false);  // the data row, sqrt(lambda) folded in
+  if (lambda < 1.0) {
+    // refresh_prior: every K samples a unit row at a round-robin index r in
+    // [0, p), absorbed from row r with scale 1.
     double prior = 0.0;
-    for (std::size_t i = 0; i < p; ++i) prior += absorb_flops(i, n);
-    f += prior / static_cast<double>(p) + 4.0;  // + the prior row's weight
+    for (std::size_t r = 0; r < p; ++r) prior += absorb_flops(r, p, track_inverse, true);
+    f += prior / d(p) / static_cast<double>(prior_refresh_period(p, lambda));
   }
   return f;
 }
 
 double rss_without_flops(std::size_t p, std::size_t first, std::size_t count) {
   const std::size_t n = p + 1;
-  if (count == 0) return 2.0 * 1.0;
-  if (first + count >= n) return 2.0 * static_cast<double>(n - first);
+  if (count == 0) return rss_prefix_flops(p, p);
+  if (first + count >= n) return rss_prefix_flops(p, first);
   const std::size_t rows = n - first;
   const std::size_t cols = n - first - count;
   double f = 0.0;
   for (std::size_t c = 0; c + 1 < cols; ++c) {
-    const std::size_t last_row = std::min(rows - 1, c + count);
-    for (std::size_t r = c + 1; r <= last_row; ++r) f += givens_flops(cols - 1 - c);
+    const double h = d(std::min(rows - 1, c + count) - c);  // entries below the diagonal
+    const double w = d(cols - 1 - c);                       // columns right of c
+    // sigma (2h); norm: mul, add, sqrt; v0: add; tau: mul, add, div.
+    f += 2.0 * h + 7.0;
+    // proj = v0 pivot (w) + sum_r v_r row_r (2hw); *= tau (w); pivot -= v0
+    // proj (2w); rows -= v_r proj (2hw).
+    f += w * (4.0 + 4.0 * h);
   }
-  return f + 2.0 * static_cast<double>(rows - cols + 1);
+  return f + sum_of_squares_flops(rows - cols + 1);
 }
 
-MonitorFlops monitor_flops(std::size_t inputs, std::size_t outputs, std::size_t na, std::size_t nb, bool forgetting) {
+double rss_without_wald_flops(std::size_t p, std::size_t first, std::size_t count) {
+  if (count == 0) return rss_prefix_flops(p, p);
+  if (first + count >= p) return rss_prefix_flops(p, first);
+  double f = 0.0;
+  // Gram matrix S = M^T M (lower triangle) and g = M^T z, row k of M
+  // having min(count, k - first + 1) nonzeros: per nonzero a, 2 for g and
+  // 2 (a + 1) for S's row a.
+  for (std::size_t k = first; k < p; ++k) {
+    const std::size_t len = std::min(count, k - first + 1);
+    for (std::size_t a = 0; a < len; ++a) f += 2.0 + 2.0 * d(a + 1);
+  }
+  // Cholesky row a: for each b <= a a dot product of b terms (2b) and a
+  // division (b < a) or the square root (b = a); forward solve: 2a, a
+  // division, and quad += t^2 (2).
+  for (std::size_t a = 0; a < count; ++a) {
+    for (std::size_t b = 0; b <= a; ++b) f += 2.0 * d(b) + 1.0;
+    f += 2.0 * d(a) + 3.0;
+  }
+  return f + rss_prefix_flops(p, p) + 1.0;  // rss() + quad
+}
+
+double solve_prefix_flops(std::size_t k) {
+  // Coefficient i: reciprocal of the diagonal and a product (2), then i
+  // multiply-subtracts into the coefficients above it (2i).
+  double f = 0.0;
+  for (std::size_t i = 0; i < k; ++i) f += 2.0 + 2.0 * d(i);
+  return f;
+}
+
+namespace {
+
+// update_statistics for one output, everything but the conditional RSS.
+double statistics_flops(std::size_t inputs, std::size_t na, std::size_t nb, bool gamma) {
   const std::size_t p_full = 1 + na + inputs * nb;
   const std::size_t p_pair = 1 + na + nb;
-  const auto m = static_cast<double>(inputs);
-  const auto n_out = static_cast<double>(outputs);
+  // rss(), rss_prefix(1 + na) twice (sigma1, lr_joint), rss_prefix(1); three
+  // divisions by sum_w; lr_joint: division, log, product; gamma_lambda^2.
+  double f = rss_prefix_flops(p_full, p_full) + 2.0 * rss_prefix_flops(p_full, 1 + na) +
+             rss_prefix_flops(p_full, 1) + 3.0 + 3.0 + 1.0;
+  for (std::size_t i = 0; i < inputs; ++i) {
+    const std::size_t p_model = i == 0 ? p_full : p_pair;  // input 0: prefix of the full model
+    f += 3.0;                                               // f_conditional, lr_conditional
+    f += rss_prefix_flops(p_model, p_pair) + rss_prefix_flops(p_model, 1 + na) + 3.0;  // pairwise F, LR
+    if (gamma) {
+      // solve_prefix; |g_hat - g_N|^2: na subtractions, na products, na - 1
+      // adds; 1 + |g_N|^2: 2 na; the quotient: 1.
+      f += solve_prefix_flops(p_pair) + 3.0 * d(na) - 1.0 + 2.0 * d(na) + 1.0;
+    }
+  }
+  return f;
+}
+
+// push_lags per channel: u - ref, the model filter's step (a multiply-add
+// per coefficient), x_1 = a x_1 + gain source (3), x_r = a x_r + x_{r-1}old
+// - a x_{r-1} (4 each, also when a = 0: the products are done).
+double channel_push_flops(std::size_t nb, std::size_t filter_taps) {
+  return 1.0 + 2.0 * d(filter_taps) + 3.0 + 4.0 * d(nb - 1);
+}
+
+}  // namespace
+
+MonitorFlops monitor_flops(std::size_t inputs, std::size_t outputs, const MonitorSettings& settings,
+                           const MonitorFlopsOptions& options) {
+  const auto na = static_cast<std::size_t>(settings.ar_order);
+  const auto nb = static_cast<std::size_t>(settings.input_order);
+  const double lambda = settings.forgetting;
+  const std::size_t p_full = 1 + na + inputs * nb;
+  const std::size_t p_pair = 1 + na + nb;
+  const bool wald = inputs >= kWaldMinInputs;
+  const double n_out = d(outputs);
   MonitorFlops f;
-  f.full_updates = n_out * sqrt_rls_update_flops(p_full, forgetting);
-  f.pairwise_updates = n_out * m * sqrt_rls_update_flops(p_pair, forgetting);
+  f.full_updates = n_out * sqrt_rls_update_flops(p_full, lambda, wald);
+  f.pairwise_updates = n_out * d(inputs - 1) * sqrt_rls_update_flops(p_pair, lambda, false);
+  // rss_without_wald is always called; without the inverse it falls back to
+  // rss_without, except for the trailing block (a free prefix sum either way).
   double conditional = 0.0;
-  for (std::size_t i = 0; i < inputs; ++i) conditional += rss_without_flops(p_full, 1 + na + i * nb, nb);
+  for (std::size_t i = 0; i < inputs; ++i) {
+    const std::size_t first = 1 + na + i * nb;
+    conditional += wald || first + nb >= p_full ? rss_without_wald_flops(p_full, first, nb)
+                                                : rss_without_flops(p_full, first, nb);
+  }
   f.conditional = n_out * conditional;
-  // Per output: three prefix sums of squares (full, AR-only, intercept-only)
-  // and three divisions. Per channel: a division, a log and a multiply for
-  // each of the two indices, the pairwise prefix sums, a back-substitution of
-  // the pairwise model (k^2 for k = p_pair) and gamma's two norms over na.
-  const double per_output = 2.0 * (1.0 + static_cast<double>(nb * inputs + 1) + static_cast<double>(p_full)) + 3.0;
-  const double per_channel = 6.0 + 2.0 * (1.0 + static_cast<double>(nb + 1)) +
-                             static_cast<double>(p_pair * p_pair) + 5.0 * static_cast<double>(na) + 2.0;
-  f.other_statistics = n_out * (per_output + m * per_channel);
+  // absorb_sample's weights (sum_w 2, sum_w2 3, n_eq 2) and update_statistics'
+  // two scales (2), once per update.
+  f.other_statistics = 9.0 + n_out * statistics_flops(inputs, na, nb, options.gamma);
+  // gain = sqrt(1 - a^2) once; per output the divergence check (dev 1, mean
+  // 2, variance 4, baseline test 1; the reference test 1 only when known,
+  // not counted); per channel the regressor push.
+  f.lags = 3.0 + n_out * 8.0 + n_out * d(inputs) * channel_push_flops(nb, options.filter_taps);
   return f;
 }
 

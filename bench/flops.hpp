@@ -2,32 +2,67 @@
 // algorithm in core/sqrt_rls.cpp and core/granger_monitor.cpp, and the
 // core's peak rate, measured by an FMA-throughput loop.
 //
-// Counting convention: one add, multiply, divide, square root or log is one
-// flop (an FMA is two). Loops are counted as the core runs them on dense data
-// (no zero is skipped: random data has none).
+// Counting convention: every add, subtract, multiply, divide and square root
+// is one flop, a multiply-add is two (so an FMA counts 2, whether or not the
+// compiler fuses it), and a log is one. Loops are counted as the core runs
+// them on dense data (no zero is skipped: random data has none). Copies,
+// comparisons and index arithmetic are not flops.
+//
+// The counts mirror the current loops line by line (see each function in
+// flops.cpp); constants private to the core (the prior's refresh period K,
+// kWaldMinInputs) are repeated there and must move with it.
 #pragma once
 
 #include <cstddef>
 #include <string>
 
+#include "core/granger_monitor.hpp"
+
 namespace mpm::bench {
 
-// Flops of SqrtRls::update with p regressors. With forgetting < 1 it also
-// scales R and absorbs one prior row starting at a round-robin index; that
-// cost is averaged over the p possible starting rows.
-double sqrt_rls_update_flops(std::size_t p, bool forgetting);
-// Flops of SqrtRls::rss_without(first, count) for p regressors.
+// Flops of SqrtRls::update (or one model's share of update_staged, the same
+// arithmetic) with p regressors and forgetting lambda: one Givens rotation
+// per row of [R | target] with sqrt(lambda) folded in, plus, when
+// track_inverse, the same rotations on R^-T, plus, when lambda < 1, the
+// kept-alive prior row re-absorbed every K samples (averaged over K and over
+// the p round-robin starting rows).
+double sqrt_rls_update_flops(std::size_t p, double lambda, bool track_inverse);
+double sqrt_rls_update_flops(std::size_t, bool, bool) = delete;  // lambda is a number, not a flag
+// The prior's refresh period K the core uses for p regressors and lambda
+// (mirrors prior_period() in core/sqrt_rls.cpp).
+int prior_refresh_period(std::size_t p, double lambda);
+// Flops of SqrtRls::rss_without(first, count) for p regressors (Householder
+// re-triangularisation of the trailing block).
 double rss_without_flops(std::size_t p, std::size_t first, std::size_t count);
+// Flops of SqrtRls::rss_without_wald(first, count) with the inverse tracked
+// (Gram matrix of the block's columns of R^-T, Cholesky, forward solve).
+double rss_without_wald_flops(std::size_t p, std::size_t first, std::size_t count);
+// Flops of SqrtRls::solve_prefix(k).
+double solve_prefix_flops(std::size_t k);
 
 struct MonitorFlops {
   double full_updates = 0.0;      // one SqrtRls per output, p = 1 + na + m nb
-  double pairwise_updates = 0.0;  // one per (output, input), p = 1 + na + nb
-  double conditional = 0.0;       // rss_without per (output, input)
-  double other_statistics = 0.0;  // prefix RSS, logs, gamma (back-substitution)
-  double total() const { return full_updates + pairwise_updates + conditional + other_statistics; }
+                                  // (with R^-T when m >= kWaldMinInputs)
+  double pairwise_updates = 0.0;  // m - 1 per output, p = 1 + na + nb (the
+                                  // first input's is a prefix of the full one)
+  double conditional = 0.0;       // rss_without or rss_without_wald per (output, input)
+  double other_statistics = 0.0;  // prefix RSS, logs, gamma (solve_prefix), n_eq
+  double lags = 0.0;              // per-sample regressor pushes (Laguerre/lag
+                                  // network, model filters), divergence check
+  double total() const { return full_updates + pairwise_updates + conditional + other_statistics + lags; }
 };
-// One used sample of GrangerMonitor::update with every statistic and gamma.
-MonitorFlops monitor_flops(std::size_t inputs, std::size_t outputs, std::size_t na, std::size_t nb, bool forgetting);
+
+// What the monitor computes besides the fixed parts.
+struct MonitorFlopsOptions {
+  bool gamma = true;              // noise models given: gamma per channel
+  std::size_t filter_taps = 0;    // model-filtered regressors: numerator +
+                                  // denominator coefficients (leading 1
+                                  // excluded) of every channel's DiscreteFilter;
+                                  // 0 = plain lags (no filter)
+};
+// One used sample of GrangerMonitor::update with every statistic.
+MonitorFlops monitor_flops(std::size_t inputs, std::size_t outputs, const MonitorSettings& settings,
+                           const MonitorFlopsOptions& options = {});
 
 struct PeakRate {
   double flops_per_s = 0.0;  // best of the vector widths this CPU runs

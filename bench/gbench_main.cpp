@@ -36,8 +36,7 @@ void BM_MonitorUpdate(benchmark::State& state) {
     allocations = scope.count();
   }
   const MonitorSettings s = paper_settings();
-  const double flops = monitor_flops(n, n, static_cast<std::size_t>(s.ar_order),
-                                     static_cast<std::size_t>(s.input_order), true).total();
+  const double flops = monitor_flops(n, n, s).total();
   state.counters["flops_per_update"] = flops;
   state.counters["flop_rate"] = benchmark::Counter(flops, benchmark::Counter::kIsIterationInvariantRate);
   state.counters["allocations"] = static_cast<double>(allocations);
@@ -77,8 +76,11 @@ void BM_SqrtRlsUpdate(benchmark::State& state) {
     ++k;
   }
   benchmark::DoNotOptimize(rls.rss());
-  state.counters["flops"] = sqrt_rls_update_flops(p, state.range(1) != 0);
-  state.counters["givens"] = static_cast<double>(p + 1) * (state.range(1) ? 1.5 : 1.0);
+  state.counters["flops"] = sqrt_rls_update_flops(p, state.range(1) ? 0.999 : 1.0, false);
+  // Rotations per update: the data row's p + 1, plus on average (p + 3) / 2
+  // for the prior row every K samples.
+  state.counters["givens"] = static_cast<double>(p + 1) +
+      (state.range(1) ? 0.5 * static_cast<double>(p + 3) / prior_refresh_period(p, 0.999) : 0.0);
 }
 BENCHMARK(BM_SqrtRlsUpdate)->ArgsProduct({{31, 41, 521}, {0, 1}});
 

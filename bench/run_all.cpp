@@ -80,16 +80,17 @@ void update_figures(Plan& plan, const PeakRate& peak, std::int64_t& allocations,
              fmt("thread CPU time, median of %.0f repeats of %.0f updates (fastest %.0f ns); na=20 nb=10 lambda=0.999, all statistics "
                  "and gamma",
                  static_cast<double>(size.repeats), static_cast<double>(size.per_repeat), t.ns_min));
-    const MonitorFlops f = monitor_flops(size.n, size.n, static_cast<std::size_t>(s.ar_order),
-                                         static_cast<std::size_t>(s.input_order), s.forgetting < 1.0);
+    const MonitorFlops f = monitor_flops(size.n, size.n, s);
     plan.add("flops_per_update_" + tag(size.n), f.total(), "flop",
-             fmt("analytic; %.0f%% conditional RSS (rss_without), %.0f%% full-model RLS, %.0f%% pairwise RLS",
-                 100.0 * f.conditional / f.total(), 100.0 * f.full_updates / f.total(),
-                 100.0 * f.pairwise_updates / f.total()));
+             fmt("analytic (bench/flops.hpp): multiply and add counted separately (FMA = 2), sqrt, divide, log 1 "
+                 "each; %.0f%% full-model RLS, %.0f%% pairwise RLS, %.0f%% conditional RSS",
+                 100.0 * f.full_updates / f.total(), 100.0 * f.pairwise_updates / f.total(),
+                 100.0 * f.conditional / f.total()));
     const double rate = f.total() / (t.ns_per_update * 1e-9);
     plan.add("peak_fraction_" + tag(size.n), rate / peak.flops_per_s, "",
-             fmt("%.2f GFLOP/s achieved / %.1f GFLOP/s measured single-core peak", rate * 1e-9,
-                 peak.flops_per_s * 1e-9));
+             fmt("%.2f GFLOP/s achieved (flops_per_update / update_ns; FMA = 2 flops) / %.1f GFLOP/s measured "
+                 "single-core peak (same convention)",
+                 rate * 1e-9, peak.flops_per_s * 1e-9));
   }
 }
 

@@ -252,7 +252,7 @@ TEST(DdsTransport, SampleWriterSeesItsReaders) {
 }
 
 // Both example configurations are ones Cyclone accepts (the plant-network
-// one with its placeholder interface replaced by this host's loopback).
+// one with its example interface name replaced by this host's loopback).
 TEST(DdsTransport, ExampleConfigurationsAreAccepted) {
   std::ifstream in(MPM_SOURCE_DIR "/deploy/dds/cyclonedds-plant-network.xml");
   std::stringstream text;
