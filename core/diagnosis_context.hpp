@@ -63,6 +63,11 @@ OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std:
 double objective(const Context& cx, const std::vector<OutputFit>& fits);
 // Fills lr and z_hold.
 void score(const Context& cx, Candidate& c);
+// A scored candidate of the given physics from its per-output fits.
+Candidate make_candidate(const Context& cx, std::string physics, std::vector<Channel> channels,
+                         std::vector<OutputFit> fits, int params);
+// Time constant in samples of a discrete pole in (0, 1); 0 otherwise.
+double tau_of(double pole);
 
 // Hypotheses. Each appends its best-fitting candidate(s).
 void channel_hypotheses(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out);

@@ -14,20 +14,6 @@ const std::string& in_name(const Context& cx, std::size_t i) { return cx.problem
 const std::string& out_name(const Context& cx, std::size_t j) { return cx.problem.outputs[j]; }
 std::string arrow(const Context& cx, std::size_t j, std::size_t i) { return in_name(cx, i) + " -> " + out_name(cx, j); }
 
-Candidate make(const Context& cx, std::string physics, std::vector<Channel> channels, std::vector<OutputFit> fits,
-               int params) {
-  Candidate c;
-  c.finding.physics = std::move(physics);
-  c.finding.channels = std::move(channels);
-  c.fits = std::move(fits);
-  c.params = params;
-  c.finding.params = params;
-  score(cx, c);
-  c.finding.lr = c.lr;
-  return c;
-}
-
-double tau_of(double pole) { return pole > 0.0 && pole < 1.0 ? -1.0 / std::log(pole) : 0.0; }
 
 // G with its slowest pole p replaced by p2; gain_scale multiplies num.
 DiscreteTf move_pole(const DiscreteTf& g, double p, double p2, double gain_scale) {
@@ -41,7 +27,7 @@ void gain(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate
   const Vec& x = cx.gu[j * cx.n_in() + i];
   OutputFit f = fit_output(cx, j, Vec(), {x});
   const double k = 1.0 + f.fit.theta(0), se = f.fit.theta_se(0);
-  Candidate c = make(cx, "gain", {{j, i}}, {std::move(f)}, 1);
+  Candidate c = make_candidate(cx, "gain", {{j, i}}, {std::move(f)}, 1);
   const DiscreteTf& g = *cx.channel(j, i);
   DiscreteTf fitted = g;
   for (double& b : fitted.num) b *= k;
@@ -67,7 +53,7 @@ void dead_time(const Context& cx, std::size_t j, std::size_t i, std::vector<Cand
     }
   }
   if (best == 0) return;
-  Candidate c = make(cx, "dead_time", {{j, i}}, {fit_output(cx, j, shifted(x, best) - x, {})}, 1);
+  Candidate c = make_candidate(cx, "dead_time", {{j, i}}, {fit_output(cx, j, shifted(x, best) - x, {})}, 1);
   DiscreteTf fitted = g;
   fitted.delay += best;
   c.finding.nominal = g;
@@ -93,7 +79,7 @@ void time_constant(const Context& cx, std::size_t j, std::size_t i, std::vector<
   for (int k = 0; k <= 16; ++k) grid.push_back(std::log(0.25) + k * (std::log(4.0) - std::log(0.25)) / 16.0);
   const double lr = minimise_on_grid(grid, [&](double v) { return objective(cx, {fit_output(cx, j, corr(v), {})}); });
   const double p2 = std::exp(-1.0 / (tau * std::exp(lr)));
-  Candidate c = make(cx, "time_constant", {{j, i}}, {fit_output(cx, j, corr(lr), {})}, 1);
+  Candidate c = make_candidate(cx, "time_constant", {{j, i}}, {fit_output(cx, j, corr(lr), {})}, 1);
   c.finding.nominal = g;
   c.finding.fitted = move_pole(g, p, p2, (1.0 - p2) / (1.0 - p));
   c.finding.parameters["time_constant_ratio"] = std::exp(lr);
@@ -111,7 +97,7 @@ void extra_lag(const Context& cx, std::size_t j, std::size_t i, std::vector<Cand
   auto corr = [&](double a) { return Vec(simulate(unit_lag(a), x) - x); };
   const double a = minimise_on_grid(grid, [&](double v) { return objective(cx, {fit_output(cx, j, corr(v), {})}); });
   if (a <= 0.0) return;
-  Candidate c = make(cx, "unmodeled_dynamics", {{j, i}}, {fit_output(cx, j, corr(a), {})}, 1);
+  Candidate c = make_candidate(cx, "unmodeled_dynamics", {{j, i}}, {fit_output(cx, j, corr(a), {})}, 1);
   c.finding.nominal = g;
   c.finding.fitted = series(g, unit_lag(a));
   c.finding.parameters["extra_lag_pole"] = a;
@@ -130,7 +116,7 @@ void integrator(const Context& cx, std::size_t j, std::size_t i, std::vector<Can
   const Vec& x = cx.gu[j * cx.n_in() + i];
   OutputFit f = fit_output(cx, j, -x, {xi});
   const double k = f.fit.theta(0);
-  Candidate c = make(cx, "integrator", {{j, i}}, {std::move(f)}, 1);
+  Candidate c = make_candidate(cx, "integrator", {{j, i}}, {std::move(f)}, 1);
   c.finding.nominal = g;
   c.finding.fitted = move_pole(g, p, 1.0, k);
   c.finding.parameters["integrator_gain_per_sample"] = k * g.dc_gain() * (1.0 - p);
@@ -174,7 +160,7 @@ void missing_channel(const Context& cx, std::size_t j, std::size_t i, std::vecto
   const Fopdt f = best_fopdt(cx, j, u, 0, 20);
   OutputFit fit = fit_output(cx, j, Vec(), {shifted(simulate(unit_lag(f.pole), u), f.delay)});
   const double k = fit.fit.theta(0);
-  Candidate c = make(cx, "missing_channel", {{j, i}}, {std::move(fit)}, 3);
+  Candidate c = make_candidate(cx, "missing_channel", {{j, i}}, {std::move(fit)}, 3);
   DiscreteTf nominal;
   if (cx.channel(j, i)) nominal = *cx.channel(j, i);
   DiscreteTf fitted;
@@ -205,6 +191,21 @@ std::string fmt(double v, int digits) {
   std::snprintf(b, sizeof b, "%.*g", digits, v);
   return b;
 }
+
+Candidate make_candidate(const Context& cx, std::string physics, std::vector<Channel> channels,
+                         std::vector<OutputFit> fits, int params) {
+  Candidate c;
+  c.finding.physics = std::move(physics);
+  c.finding.channels = std::move(channels);
+  c.fits = std::move(fits);
+  c.params = params;
+  c.finding.params = params;
+  score(cx, c);
+  c.finding.lr = c.lr;
+  return c;
+}
+
+double tau_of(double pole) { return pole > 0.0 && pole < 1.0 ? -1.0 / std::log(pole) : 0.0; }
 
 void channel_hypotheses(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
   if (!cx.excited[i]) return;

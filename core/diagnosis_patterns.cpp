@@ -32,26 +32,12 @@ std::vector<OutputFit> input_change_fits(const Context& cx, std::size_t i, const
   return fits;
 }
 
-Candidate make(const Context& cx, std::string physics, std::vector<Channel> channels, std::vector<OutputFit> fits,
-               int params) {
-  Candidate c;
-  c.finding.physics = std::move(physics);
-  c.finding.channels = std::move(channels);
-  c.fits = std::move(fits);
-  c.params = params;
-  c.finding.params = params;
-  score(cx, c);
-  c.finding.lr = c.lr;
-  return c;
-}
-
-double tau_of(double pole) { return pole > 0.0 && pole < 1.0 ? -1.0 / std::log(pole) : 0.0; }
 
 void actuator(const Context& cx, std::size_t i, const std::vector<std::size_t>& js, std::vector<Candidate>& out) {
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
   auto fits = [&](double a) { return input_change_fits(cx, i, js, simulate(unit_lag(a), u)); };
   const double a = minimise_on_grid(lag_pole_grid(0.3, 30.0, 16), [&](double v) { return objective(cx, fits(v)); });
-  Candidate c = make(cx, "actuator_dynamics", column_channels(js, i), fits(a), 1);
+  Candidate c = make_candidate(cx, "actuator_dynamics", column_channels(js, i), fits(a), 1);
   c.finding.nominal = *cx.channel(js[0], i);
   c.finding.fitted = series(*cx.channel(js[0], i), unit_lag(a));
   c.finding.parameters["actuator_lag_pole"] = a;
@@ -87,7 +73,7 @@ void saturation(const Context& cx, std::size_t i, const std::vector<std::size_t>
     }
   }
   const Vec v = upper ? clipped(u, -1e300, best_limit) : clipped(u, best_limit, 1e300);
-  Candidate c = make(cx, "saturation", column_channels(js, i), input_change_fits(cx, i, js, v), 1);
+  Candidate c = make_candidate(cx, "saturation", column_channels(js, i), input_change_fits(cx, i, js, v), 1);
   const double u0 = cx.problem.u_abs(0, static_cast<Index>(i)) - cx.problem.du(0, static_cast<Index>(i));
   c.finding.nominal = *cx.channel(js[0], i);
   c.finding.fitted = *cx.channel(js[0], i);
@@ -105,7 +91,7 @@ void deadband(const Context& cx, std::size_t i, const std::vector<std::size_t>& 
   for (int k = 0; k <= 14; ++k) grid.push_back(std::log(0.05 * scale) + k * std::log(200.0) / 14.0);
   auto fits = [&](double lw) { return input_change_fits(cx, i, js, backlash(u, std::exp(lw))); };
   const double lw = minimise_on_grid(grid, [&](double v) { return objective(cx, fits(v)); });
-  Candidate c = make(cx, "deadband", column_channels(js, i), fits(lw), 1);
+  Candidate c = make_candidate(cx, "deadband", column_channels(js, i), fits(lw), 1);
   c.finding.nominal = *cx.channel(js[0], i);
   c.finding.fitted = *cx.channel(js[0], i);
   c.finding.parameters["backlash_width"] = std::exp(lw);
@@ -121,7 +107,7 @@ void nonlinear_gain(const Context& cx, std::size_t i, const std::vector<std::siz
   std::vector<OutputFit> fits;
   for (std::size_t j : js) fits.push_back(fit_output(cx, j, Vec(), {simulate(*cx.channel(j, i), u2)}));
   const double b = fits[0].fit.theta(0);
-  Candidate c = make(cx, "nonlinear_gain", column_channels(js, i), std::move(fits), static_cast<int>(js.size()));
+  Candidate c = make_candidate(cx, "nonlinear_gain", column_channels(js, i), std::move(fits), static_cast<int>(js.size()));
   c.finding.nominal = *cx.channel(js[0], i);
   c.finding.fitted = *cx.channel(js[0], i);
   c.finding.parameters["gain_slope_per_unit"] = 2.0 * b;
@@ -153,7 +139,7 @@ void row_hypotheses(const Context& cx, std::size_t j, std::vector<Candidate>& ou
   if (cs.size() < 2) return;
   auto fits = [&](double a) { return std::vector<OutputFit>{fit_output(cx, j, simulate(unit_lag(a), total) - total, {})}; };
   const double a = minimise_on_grid(lag_pole_grid(0.3, 30.0, 16), [&](double v) { return objective(cx, fits(v)); });
-  Candidate c = make(cx, "sensor_dynamics", cs, fits(a), 1);
+  Candidate c = make_candidate(cx, "sensor_dynamics", cs, fits(a), 1);
   c.finding.nominal = *cx.channel(j, cs[0].input.value());
   c.finding.fitted = series(*cx.channel(j, cs[0].input.value()), unit_lag(a));
   c.finding.parameters["sensor_lag_pole"] = a;
@@ -174,7 +160,7 @@ void signal_hypotheses(const Context& cx, std::size_t j, std::size_t column, std
     DiscreteTf tf = *cx.channel(j, i);
     for (double& b : tf.num) b *= f[0].fit.theta(0);
     const std::string how = "acts like " + cx.problem.inputs[i] + " (through its channel, x " + fmt(f[0].fit.theta(0)) + ")";
-    Candidate c = make(cx, "unmodeled_input", {{j, std::nullopt}}, std::move(f), 1);
+    Candidate c = make_candidate(cx, "unmodeled_input", {{j, std::nullopt}}, std::move(f), 1);
     c.finding.signal = name;
     c.finding.fitted = tf;
     c.finding.summary = "recorded signal " + name + " drives " + cx.problem.outputs[j] + ": it " + how;
@@ -201,7 +187,7 @@ void signal_hypotheses(const Context& cx, std::size_t j, std::size_t column, std
   tf.num = {k * (1.0 - fo.pole)};
   tf.den = {1.0, -fo.pole};
   tf.delay = fo.delay;
-  Candidate c = make(cx, "unmodeled_input", {{j, std::nullopt}}, std::move(f), 3);
+  Candidate c = make_candidate(cx, "unmodeled_input", {{j, std::nullopt}}, std::move(f), 3);
   c.finding.signal = name;
   c.finding.fitted = tf;
   c.finding.summary = "recorded signal " + name + " drives " + cx.problem.outputs[j] + " through gain " + fmt(k) +
