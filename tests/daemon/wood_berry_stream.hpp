@@ -16,10 +16,10 @@ namespace mpm::test {
 
 class WoodBerryStream {
  public:
-  // Inputs about config/wood-berry.yaml's operating point (0, 0), so the
+  // Inputs about config/wood-berry.yaml's operating point (15, 12), so the
   // nominal model and the plant start from the same rest; outputs offset (the
   // monitor's intercept must absorb it).
-  static constexpr std::array<double, 2> kU0{0.0, 0.0};
+  static constexpr std::array<double, 2> kU0{15.0, 12.0};
   static constexpr std::array<double, 2> kY0{90.0, 5.0};
 
   explicit WoodBerryStream(std::uint64_t seed, double input_std = 5.0) : rng_(seed), input_std_(input_std) {}
