@@ -131,9 +131,7 @@ int run(int argc, char** argv) {
     o.plant = args.get("plant").value_or(net.daemon ? net.daemon->plant_path : "");
     if (o.plant.empty()) throw UsageError("--plant (or --config) is required");
     o.controller = args.get("controller").value_or(net.daemon ? net.daemon->controller_id : "");
-    if (args.flag("as-fast-as-possible") && args.get("rate")) throw UsageError("--rate and --as-fast-as-possible exclude each other");
-    o.rate = args.flag("as-fast-as-possible") ? 0.0 : args.number("rate", -1);
-    if (args.get("rate") && !(o.rate > 0)) throw UsageError("--rate: expected samples per second > 0");
+    o.rate = net_cli::read_rate(args);
     o.session = args.get("session") ? static_cast<std::int64_t>(args.number("session", 0)) : random_session();
     o.first_seq = static_cast<std::int64_t>(args.number("first-seq", 1));
     o.wait_readers = args.number("wait-readers", 10);

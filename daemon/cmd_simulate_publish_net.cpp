@@ -104,9 +104,7 @@ int run(int argc, char** argv) {
     o.controller = args.get("controller").value_or(net.daemon ? net.daemon->controller_id : "");
     o.samples = args.integer("samples", 0);
     o.seed = static_cast<unsigned long>(args.integer("seed", 1));
-    if (args.flag("as-fast-as-possible") && args.get("rate")) throw UsageError("--rate and --as-fast-as-possible exclude each other");
-    o.rate = args.flag("as-fast-as-possible") ? 0.0 : args.number("rate", -1);
-    if (args.get("rate") && !(o.rate > 0)) throw UsageError("--rate: expected samples per second > 0");
+    o.rate = net_cli::read_rate(args);
     if (o.samples < 0) throw UsageError("--samples must not be negative");
     o.wait_readers = args.number("wait-readers", 10);
   } catch (const UsageError& e) {

@@ -57,4 +57,14 @@ inline NetOptions read(const Args& args) {
   return o;
 }
 
+// Pacing of a publisher: --rate HZ or --as-fast-as-possible (rate 0); -1 when
+// neither is given (the caller then paces at 1 / sample_time).
+inline double read_rate(const Args& args) {
+  if (args.flag("as-fast-as-possible") && args.get("rate"))
+    throw UsageError("--rate and --as-fast-as-possible exclude each other");
+  const double rate = args.flag("as-fast-as-possible") ? 0.0 : args.number("rate", -1);
+  if (args.get("rate") && !(rate > 0)) throw UsageError("--rate: expected samples per second > 0");
+  return rate;
+}
+
 }  // namespace mpm::net_cli
