@@ -16,7 +16,10 @@ bool has_length(const std::vector<T>& v, std::int32_t n) {
   return n >= 0 && v.size() == static_cast<std::size_t>(n);
 }
 
-void to_wire(const msg::ChannelStatus& in, mpm_lcm::channel_status_t& out) {
+// Our message structs and the generated LCM types use the same field names:
+// one copy per message kind serves both directions.
+template <typename From, typename To>
+void copy_channel(const From& in, To& out) {
   out.output = in.output;
   out.input = in.input;
   out.f_pairwise = in.f_pairwise;
@@ -27,7 +30,8 @@ void to_wire(const msg::ChannelStatus& in, mpm_lcm::channel_status_t& out) {
   out.alarm = in.alarm;
 }
 
-void to_wire(const msg::LoopStatus& in, mpm_lcm::loop_status_t& out) {
+template <typename From, typename To>
+void copy_loop(const From& in, To& out) {
   out.output = in.output;
   out.residual_variance = in.residual_variance;
   out.sigma1 = in.sigma1;
@@ -36,24 +40,44 @@ void to_wire(const msg::LoopStatus& in, mpm_lcm::loop_status_t& out) {
   out.diverging = in.diverging;
 }
 
-void from_wire(const mpm_lcm::channel_status_t& in, msg::ChannelStatus& out) {
+template <typename From, typename To>
+void copy_alarm(const From& in, To& out) {
+  out.controller_id = in.controller_id;
+  out.utime = in.utime;
+  out.sample_sequence = in.sample_sequence;
   out.output = in.output;
   out.input = in.input;
-  out.f_pairwise = in.f_pairwise;
-  out.f_conditional = in.f_conditional;
-  out.lr = in.lr;
+  out.output_index = in.output_index;
+  out.input_index = in.input_index;
+  out.raised = in.raised;
+  out.f = in.f;
   out.p_value = in.p_value;
   out.gamma = in.gamma;
-  out.alarm = in.alarm;
+  out.physics = in.physics;
+  out.text = in.text;
 }
 
-void from_wire(const mpm_lcm::loop_status_t& in, msg::LoopStatus& out) {
-  out.output = in.output;
-  out.residual_variance = in.residual_variance;
-  out.sigma1 = in.sigma1;
-  out.sigma_full = in.sigma_full;
-  out.alarm = in.alarm;
-  out.diverging = in.diverging;
+// Everything of a status but its two arrays.
+template <typename From, typename To>
+void copy_status_scalars(const From& in, To& out) {
+  out.controller_id = in.controller_id;
+  out.utime = in.utime;
+  out.uptime_ms = in.uptime_ms;
+  out.ready = in.ready;
+  out.effective_samples = in.effective_samples;
+  out.raise_threshold = in.raise_threshold;
+  out.clear_threshold = in.clear_threshold;
+  out.samples_seen = in.samples_seen;
+  out.samples_used = in.samples_used;
+  out.dropped = in.dropped;
+  out.gaps = in.gaps;
+  out.missing = in.missing;
+  out.duplicates = in.duplicates;
+  out.out_of_order = in.out_of_order;
+  out.restarts = in.restarts;
+  out.malformed = in.malformed;
+  out.nan_samples = in.nan_samples;
+  out.alarms_raised = in.alarms_raised;
 }
 
 }  // namespace
@@ -76,46 +100,15 @@ void to_wire(const msg::Sample& in, mpm_lcm::sample_t& out) {
   out.n_extra = static_cast<std::int32_t>(n_extra);
 }
 
-void to_wire(const msg::Alarm& in, mpm_lcm::alarm_t& out) {
-  out.controller_id = in.controller_id;
-  out.utime = in.utime;
-  out.sample_sequence = in.sample_sequence;
-  out.output = in.output;
-  out.input = in.input;
-  out.output_index = in.output_index;
-  out.input_index = in.input_index;
-  out.raised = in.raised;
-  out.f = in.f;
-  out.p_value = in.p_value;
-  out.gamma = in.gamma;
-  out.physics = in.physics;
-  out.text = in.text;
-}
+void to_wire(const msg::Alarm& in, mpm_lcm::alarm_t& out) { copy_alarm(in, out); }
 
 void to_wire(const msg::Status& in, mpm_lcm::status_t& out) {
-  out.controller_id = in.controller_id;
-  out.utime = in.utime;
-  out.uptime_ms = in.uptime_ms;
-  out.ready = in.ready;
-  out.effective_samples = in.effective_samples;
-  out.raise_threshold = in.raise_threshold;
-  out.clear_threshold = in.clear_threshold;
-  out.samples_seen = in.samples_seen;
-  out.samples_used = in.samples_used;
-  out.dropped = in.dropped;
-  out.gaps = in.gaps;
-  out.missing = in.missing;
-  out.duplicates = in.duplicates;
-  out.out_of_order = in.out_of_order;
-  out.restarts = in.restarts;
-  out.malformed = in.malformed;
-  out.nan_samples = in.nan_samples;
-  out.alarms_raised = in.alarms_raised;
+  copy_status_scalars(in, out);
   out.channels.resize(in.channels.size());
-  for (std::size_t i = 0; i < in.channels.size(); ++i) to_wire(in.channels[i], out.channels[i]);
+  for (std::size_t i = 0; i < in.channels.size(); ++i) copy_channel(in.channels[i], out.channels[i]);
   out.n_channels = length(in.channels);
   out.loops.resize(in.loops.size());
-  for (std::size_t i = 0; i < in.loops.size(); ++i) to_wire(in.loops[i], out.loops[i]);
+  for (std::size_t i = 0; i < in.loops.size(); ++i) copy_loop(in.loops[i], out.loops[i]);
   out.n_loops = length(in.loops);
 }
 
@@ -138,46 +131,17 @@ bool from_wire(const mpm_lcm::sample_t& in, msg::Sample& out) {
 }
 
 bool from_wire(const mpm_lcm::alarm_t& in, msg::Alarm& out) {
-  out.controller_id = in.controller_id;
-  out.utime = in.utime;
-  out.sample_sequence = in.sample_sequence;
-  out.output = in.output;
-  out.input = in.input;
-  out.output_index = in.output_index;
-  out.input_index = in.input_index;
-  out.raised = in.raised;
-  out.f = in.f;
-  out.p_value = in.p_value;
-  out.gamma = in.gamma;
-  out.physics = in.physics;
-  out.text = in.text;
+  copy_alarm(in, out);
   return true;
 }
 
 bool from_wire(const mpm_lcm::status_t& in, msg::Status& out) {
   if (!has_length(in.channels, in.n_channels) || !has_length(in.loops, in.n_loops)) return false;
-  out.controller_id = in.controller_id;
-  out.utime = in.utime;
-  out.uptime_ms = in.uptime_ms;
-  out.ready = in.ready;
-  out.effective_samples = in.effective_samples;
-  out.raise_threshold = in.raise_threshold;
-  out.clear_threshold = in.clear_threshold;
-  out.samples_seen = in.samples_seen;
-  out.samples_used = in.samples_used;
-  out.dropped = in.dropped;
-  out.gaps = in.gaps;
-  out.missing = in.missing;
-  out.duplicates = in.duplicates;
-  out.out_of_order = in.out_of_order;
-  out.restarts = in.restarts;
-  out.malformed = in.malformed;
-  out.nan_samples = in.nan_samples;
-  out.alarms_raised = in.alarms_raised;
+  copy_status_scalars(in, out);
   out.channels.resize(in.channels.size());
-  for (std::size_t i = 0; i < in.channels.size(); ++i) from_wire(in.channels[i], out.channels[i]);
+  for (std::size_t i = 0; i < in.channels.size(); ++i) copy_channel(in.channels[i], out.channels[i]);
   out.loops.resize(in.loops.size());
-  for (std::size_t i = 0; i < in.loops.size(); ++i) from_wire(in.loops[i], out.loops[i]);
+  for (std::size_t i = 0; i < in.loops.size(); ++i) copy_loop(in.loops[i], out.loops[i]);
   return true;
 }
 
