@@ -71,8 +71,12 @@ void to_wire(const msg::Alarm& in, mpm_dds_Alarm& out) {
   out.text = view(in.text);
 }
 
-void to_wire(const msg::Status& in, mpm_dds_Status& out, Scratch& scratch) {
-  out.controller_id = view(in.controller_id);
+namespace {
+
+// The numeric fields of a status have the same names on both sides: one copy
+// serves both directions (strings and sequences are converted by hand).
+template <typename From, typename To>
+void copy_status_numbers(const From& in, To& out) {
   out.utime = in.utime;
   out.uptime_ms = in.uptime_ms;
   out.ready = in.ready;
@@ -90,6 +94,13 @@ void to_wire(const msg::Status& in, mpm_dds_Status& out, Scratch& scratch) {
   out.malformed = in.malformed;
   out.nan_samples = in.nan_samples;
   out.alarms_raised = in.alarms_raised;
+}
+
+}  // namespace
+
+void to_wire(const msg::Status& in, mpm_dds_Status& out, Scratch& scratch) {
+  out.controller_id = view(in.controller_id);
+  copy_status_numbers(in, out);
   scratch.channels.resize(in.channels.size());
   for (std::size_t i = 0; i < in.channels.size(); ++i) {
     const auto& c = in.channels[i];
@@ -139,23 +150,7 @@ void from_wire(const mpm_dds_Alarm& in, msg::Alarm& out) {
 
 void from_wire(const mpm_dds_Status& in, msg::Status& out) {
   assign(out.controller_id, in.controller_id);
-  out.utime = in.utime;
-  out.uptime_ms = in.uptime_ms;
-  out.ready = in.ready;
-  out.effective_samples = in.effective_samples;
-  out.raise_threshold = in.raise_threshold;
-  out.clear_threshold = in.clear_threshold;
-  out.samples_seen = in.samples_seen;
-  out.samples_used = in.samples_used;
-  out.dropped = in.dropped;
-  out.gaps = in.gaps;
-  out.missing = in.missing;
-  out.duplicates = in.duplicates;
-  out.out_of_order = in.out_of_order;
-  out.restarts = in.restarts;
-  out.malformed = in.malformed;
-  out.nan_samples = in.nan_samples;
-  out.alarms_raised = in.alarms_raised;
+  copy_status_numbers(in, out);
   out.channels.resize(in.channels._length);
   for (std::uint32_t i = 0; i < in.channels._length; ++i) {
     const auto& c = in.channels._buffer[i];
