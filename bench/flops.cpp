@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "bench/cpu_clock.hpp"
+#include "core/givens.hpp"
 
 #if defined(__x86_64__)
 #include <immintrin.h>
@@ -13,8 +14,6 @@ namespace mpm::bench {
 namespace {
 
 // Mirrors of constants private to the core (keep in step with it).
-constexpr int kMaxPriorPeriod = 10;        // core/sqrt_rls.cpp
-constexpr double kPriorDip = 0.25;         // core/sqrt_rls.cpp
 constexpr std::size_t kWaldMinInputs = 4;  // core/granger_monitor.cpp
 
 double d(std::size_t n) { return static_cast<double>(n); }
@@ -52,11 +51,7 @@ double rss_prefix_flops(std::size_t p, std::size_t k) { return sum_of_squares_fl
 
 }  // namespace
 
-int prior_refresh_period(std::size_t p, double lambda) {
-  if (lambda >= 1.0) return 1;
-  const double k = std::floor(std::log(kPriorDip) / (d(p) * std::log(lambda)));
-  return static_cast<int>(std::clamp(k, 1.0, static_cast<double>(kMaxPriorPeriod)));
-}
+int prior_refresh_period(std::size_t p, double lambda) { return givens::prior_period(p, lambda); }
 
 double sqrt_rls_update_flops(std::size_t p, double lambda, bool track_inverse) {
   double f = absorb_flops(0, p, track_inverse, false);  // the data row, sqrt(lambda) folded in
@@ -121,21 +116,32 @@ double solve_prefix_flops(std::size_t k) {
 namespace {
 
 // update_statistics for one output, everything but the conditional RSS.
+// NestedRls of the output: prefix a = 1 + na, lower factor of P = m nb
+// regressors, pairwise factors of nb (the first input's: a prefix of the
+// lower factor).
 double statistics_flops(std::size_t inputs, std::size_t na, std::size_t nb, bool gamma) {
-  const std::size_t p_full = 1 + na + inputs * nb;
-  const std::size_t p_pair = 1 + na + nb;
-  // rss(), rss_prefix(1 + na) twice (sigma1, lr_joint), rss_prefix(1); three
-  // divisions by sum_w; lr_joint: division, log, product; gamma_lambda^2.
-  double f = rss_prefix_flops(p_full, p_full) + 2.0 * rss_prefix_flops(p_full, 1 + na) +
-             rss_prefix_flops(p_full, 1) + 3.0 + 3.0 + 1.0;
+  const std::size_t a = 1 + na;
+  const std::size_t p_lower = inputs * nb;
+  // rss_full, rss_prefix_only, rss_head(1) (rss_prefix_only again plus the
+  // a - 1 trapezoid rows); three divisions by sum_w; lr_joint: division,
+  // log, product; gamma_lambda^2.
+  double f = rss_prefix_flops(p_lower, p_lower) + 2.0 * rss_prefix_flops(p_lower, 0) + sum_of_squares_flops(a - 1) +
+             1.0 + 3.0 + 3.0 + 1.0;
   for (std::size_t i = 0; i < inputs; ++i) {
-    const std::size_t p_model = i == 0 ? p_full : p_pair;  // input 0: prefix of the full model
-    f += 3.0;                                               // f_conditional, lr_conditional
-    f += rss_prefix_flops(p_model, p_pair) + rss_prefix_flops(p_model, 1 + na) + 3.0;  // pairwise F, LR
+    f += 3.0;  // f_conditional (division, log), lr_conditional
+    // Pairwise F: its A-only RSS and its RSS (input 0: prefix sums of the
+    // lower factor; else the pairwise factor's), division, log, product.
+    f += i == 0 ? rss_prefix_flops(p_lower, 0) + rss_prefix_flops(p_lower, nb)
+                : rss_prefix_flops(nb, 0) + rss_prefix_flops(nb, nb);
+    f += 3.0;
     if (gamma) {
-      // solve_prefix; |g_hat - g_N|^2: na subtractions, na products, na - 1
-      // adds; 1 + |g_N|^2: 2 na; the quotient: 1.
-      f += solve_prefix_flops(p_pair) + 3.0 * d(na) - 1.0 + 2.0 * d(na) + 1.0;
+      // solve_pairs_prefix, this input's share: nb coefficients of its block
+      // (back substitution), the trapezoid's right-hand side (a rows of nb
+      // multiply-subtracts) and its product with the tracked R_AA^-T (a
+      // triangle of multiply-adds); |g_hat - g_N|^2: na subtractions, na
+      // products, na - 1 adds; 1 + |g_N|^2: 2 na; the quotient: 1.
+      f += solve_prefix_flops(nb) + 2.0 * d(a) * d(nb) + d(a) * d(a + 1);
+      f += 3.0 * d(na) - 1.0 + 2.0 * d(na) + 1.0;
     }
   }
   return f;
@@ -155,20 +161,40 @@ MonitorFlops monitor_flops(std::size_t inputs, std::size_t outputs, const Monito
   const auto na = static_cast<std::size_t>(settings.ar_order);
   const auto nb = static_cast<std::size_t>(settings.input_order);
   const double lambda = settings.forgetting;
-  const std::size_t p_full = 1 + na + inputs * nb;
-  const std::size_t p_pair = 1 + na + nb;
+  const std::size_t a = 1 + na;
+  const std::size_t p_lower = inputs * nb;
+  const std::size_t cols = a + p_lower + 1;
   const bool wald = inputs >= kWaldMinInputs;
   const double n_out = d(outputs);
   MonitorFlops f;
-  f.full_updates = n_out * sqrt_rls_update_flops(p_full, lambda, wald);
-  f.pairwise_updates = n_out * d(inputs - 1) * sqrt_rls_update_flops(p_pair, lambda, false);
-  // rss_without_wald is always called; without the inverse it falls back to
-  // rss_without, except for the trailing block (a free prefix sum either way).
+  // NestedRls per output: the trapezoid of the a prefix rows (rotation i
+  // over the columns after i), the lower factor, and every K_a samples the
+  // trapezoid's prior row (from a round-robin row r) passed on to the lower
+  // and pairwise factors with weight 1.
+  double shared = 0.0;
+  // (Each trapezoid rotation also turns the tracked R_AA^-T's row i.)
+  for (std::size_t i = 0; i < a; ++i) shared += rotation_flops(cols - 1 - i) + inverse_rotation_flops(i + 1, false);
+  shared += sqrt_rls_update_flops(p_lower, lambda, wald);
+  if (lambda < 1.0) {
+    double prior = 0.0;
+    for (std::size_t r = 0; r < a; ++r)
+      for (std::size_t i = r; i < a; ++i) prior += rotation_flops(cols - 1 - i) + inverse_rotation_flops(i + 1, true);
+    prior /= d(a);
+    prior += absorb_flops(0, p_lower, wald, true) + d(inputs - 1) * absorb_flops(0, nb, false, true);
+    shared += prior / static_cast<double>(prior_refresh_period(a, lambda));
+  }
+  f.full_updates = n_out * shared;
+  f.pairwise_updates = n_out * d(inputs - 1) * sqrt_rls_update_flops(nb, lambda, false);
+  // rss_without_block: one input, the prefix-only RSS; two, a pairwise RSS
+  // or a prefix sum; more, rss_without_wald on the lower factor (which falls
+  // back to rss_without without the inverse, except for the trailing block).
   double conditional = 0.0;
   for (std::size_t i = 0; i < inputs; ++i) {
-    const std::size_t first = 1 + na + i * nb;
-    conditional += wald || first + nb >= p_full ? rss_without_wald_flops(p_full, first, nb)
-                                                : rss_without_flops(p_full, first, nb);
+    const std::size_t first = i * nb;
+    if (inputs == 1) conditional += rss_prefix_flops(p_lower, 0);
+    else if (inputs == 2) conditional += i == 0 ? rss_prefix_flops(nb, nb) : rss_prefix_flops(p_lower, nb);
+    else conditional += wald || first + nb >= p_lower ? rss_without_wald_flops(p_lower, first, nb)
+                                                      : rss_without_flops(p_lower, first, nb);
   }
   f.conditional = n_out * conditional;
   // absorb_sample's weights (sum_w 2, sum_w2 3, n_eq 2) and update_statistics'

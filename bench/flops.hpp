@@ -1,5 +1,6 @@
 // Floating-point work of one monitor update, counted analytically from the
-// algorithm in core/sqrt_rls.cpp and core/granger_monitor.cpp, and the
+// algorithm in core/sqrt_rls.cpp, core/nested_rls.cpp and
+// core/granger_monitor.cpp, and the
 // core's peak rate, measured by an FMA-throughput loop.
 //
 // Counting convention: every add, subtract, multiply, divide and square root
@@ -9,8 +10,8 @@
 // comparisons and index arithmetic are not flops.
 //
 // The counts mirror the current loops line by line (see each function in
-// flops.cpp); constants private to the core (the prior's refresh period K,
-// kWaldMinInputs) are repeated there and must move with it.
+// flops.cpp); kWaldMinInputs, private to the core, is repeated there and
+// must move with it.
 #pragma once
 
 #include <cstddef>
@@ -29,7 +30,7 @@ namespace mpm::bench {
 double sqrt_rls_update_flops(std::size_t p, double lambda, bool track_inverse);
 double sqrt_rls_update_flops(std::size_t, bool, bool) = delete;  // lambda is a number, not a flag
 // The prior's refresh period K the core uses for p regressors and lambda
-// (mirrors prior_period() in core/sqrt_rls.cpp).
+// (core/givens.hpp).
 int prior_refresh_period(std::size_t p, double lambda);
 // Flops of SqrtRls::rss_without(first, count) for p regressors (Householder
 // re-triangularisation of the trailing block).
@@ -41,11 +42,12 @@ double rss_without_wald_flops(std::size_t p, std::size_t first, std::size_t coun
 double solve_prefix_flops(std::size_t k);
 
 struct MonitorFlops {
-  double full_updates = 0.0;      // one SqrtRls per output, p = 1 + na + m nb
-                                  // (with R^-T when m >= kWaldMinInputs)
-  double pairwise_updates = 0.0;  // m - 1 per output, p = 1 + na + nb (the
-                                  // first input's is a prefix of the full one)
-  double conditional = 0.0;       // rss_without or rss_without_wald per (output, input)
+  double full_updates = 0.0;      // one NestedRls per output: the shared rows of
+                                  // [1, AR] and the lower factor of m nb (with
+                                  // its inverse when m >= kWaldMinInputs)
+  double pairwise_updates = 0.0;  // m - 1 pairwise lower factors of nb per
+                                  // output (the first input's is a prefix)
+  double conditional = 0.0;       // rss_without_block per (output, input)
   double other_statistics = 0.0;  // prefix RSS, logs, gamma (solve_prefix), n_eq
   double lags = 0.0;              // per-sample regressor pushes (Laguerre/lag
                                   // network, model filters), divergence check

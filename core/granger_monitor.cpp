@@ -16,9 +16,6 @@ constexpr double kRegularization = 1e-9;
 // doubling the full model's update) instead of re-triangularisation
 // (O(p^2 nb) per input); below it the extra update costs more than it saves.
 constexpr std::size_t kWaldMinInputs = 4;
-// Models updated together (see SqrtRls::update_staged): enough independent
-// rotation chains to hide the square-root and division latency.
-constexpr std::size_t kLockstep = 8;
 // Divergence: the residual's short-memory variance exceeds this many times
 // the matched-model variance (amplitude x 10), or, where that is unknown,
 // 1000 times the quietest level it had: the loop is not stationary and a
@@ -64,7 +61,6 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   na_ = static_cast<std::size_t>(settings.ar_order);
   nb_ = static_cast<std::size_t>(settings.input_order);
   const std::size_t p_full = n_regressors();
-  const std::size_t p_pair = 1 + na_ + nb_;
   input_lags_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nb_), static_cast<Eigen::Index>(n_outputs * n_inputs));
   channel_filters_.resize(n_outputs * n_inputs);
   if (!channel_models.empty() && channel_models.size() != n_outputs * n_inputs)
@@ -95,14 +91,14 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
     lags_needed_ = std::max(lags_needed_, static_cast<int>(nb_) + static_cast<int>(std::ceil(std::log(0.01) / std::log(settings.input_pole))));
   warmup_ = settings.warmup > 0 ? settings.warmup : static_cast<int>(10 * p_full);
 
-  full_.assign(n_outputs, SqrtRls(p_full, settings.forgetting, kRegularization, n_inputs >= kWaldMinInputs));
-  // The pairwise model of input 1, [1, AR, u_1], is a prefix of the full one.
-  pairwise_.assign(n_outputs * (n_inputs - 1), SqrtRls(p_pair, settings.forgetting, kRegularization));
+  regressions_.assign(n_outputs, NestedRls(1 + na_, n_inputs, nb_, settings.forgetting, kRegularization,
+                                           n_inputs >= kWaldMinInputs));
+  for (NestedRls& r : regressions_) regression_ptrs_.push_back(&r);
   residual_lags_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(na_), static_cast<Eigen::Index>(n_outputs));
   input_ref_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_inputs));
-  coef_.resize(static_cast<Eigen::Index>(p_full));
-  pair_coef_.resize(static_cast<Eigen::Index>(p_pair));
-  scratch_.resize(static_cast<Eigen::Index>(p_full + 1), static_cast<Eigen::Index>(p_full + 1));
+  pair_coef_.resize(static_cast<Eigen::Index>(1 + na_));
+  const auto lower = static_cast<Eigen::Index>(n_inputs * nb_ + 1);
+  scratch_.resize(lower, lower);
 
   n_inverse_ar_.resize(n_outputs);
   for (std::size_t j = 0; j < n_inverse_ar.size(); ++j) {
@@ -132,8 +128,7 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
 }
 
 void GrangerMonitor::reset() noexcept {
-  for (auto& r : full_) r.reset();
-  for (auto& r : pairwise_) r.reset();
+  for (auto& r : regressions_) r.reset();
   residual_lags_.setZero();
   input_lags_.setZero();
   for (auto& f : channel_filters_)
@@ -197,39 +192,19 @@ void GrangerMonitor::absorb_sample(const double* residual) noexcept {
   sum_w2_ = lambda * lambda * sum_w2_ + 1.0;
   n_eq_ = sum_w_ * sum_w_ / sum_w2_;
 
-  // Regressor rows written straight into each model's staged row:
+  // Regressor rows written straight into each output's staged row:
   // [1, AR lags of d~_j, lags of u_1, ..., u_m, target d~_j(k)].
-  const std::size_t nb = nb_;
+  const std::size_t inputs = n_inputs_ * nb_;
   for (std::size_t j = 0; j < n_outputs_; ++j) {
     const double* ar = residual_lags_.col(static_cast<Eigen::Index>(j)).data();
     const double* lags = input_lags_.col(static_cast<Eigen::Index>(j * n_inputs_)).data();  // nb per input
-    double* f = full_[j].staged_row();
+    double* f = regressions_[j].staged_row();
     f[0] = 1.0;
     std::copy(ar, ar + na_, f + 1);
-    std::copy(lags, lags + n_inputs_ * nb, f + 1 + na_);
-    f[1 + na_ + n_inputs_ * nb] = residual[j];
-    for (std::size_t i = 1; i < n_inputs_; ++i) {
-      double* q = pairwise_[j * (n_inputs_ - 1) + i - 1].staged_row();
-      q[0] = 1.0;
-      std::copy(ar, ar + na_, q + 1);
-      std::copy(lags + i * nb, lags + (i + 1) * nb, q + 1 + na_);
-      q[1 + na_ + nb] = residual[j];
-    }
+    std::copy(lags, lags + inputs, f + 1 + na_);
+    f[1 + na_ + inputs] = residual[j];
   }
-  // Independent models in lockstep, a few at a time (all full models first,
-  // then the pairwise ones, so that sizes in a group are alike).
-  SqrtRls* group[kLockstep];
-  std::size_t in_group = 0;
-  const auto add = [&](SqrtRls& model) {
-    group[in_group++] = &model;
-    if (in_group == kLockstep) {
-      SqrtRls::update_staged(group, in_group);
-      in_group = 0;
-    }
-  };
-  for (SqrtRls& model : full_) add(model);
-  for (SqrtRls& model : pairwise_) add(model);
-  if (in_group > 0) SqrtRls::update_staged(group, in_group);
+  NestedRls::update_staged(regression_ptrs_.data(), regression_ptrs_.size());
 }
 
 void GrangerMonitor::push_lags(const double* u, const double* residual) noexcept {
@@ -282,32 +257,31 @@ void GrangerMonitor::update_statistics() noexcept {
   const double scale_pair = std::max(n_eq_ - static_cast<double>(p_pair), 1.0);
   const bool testing = ready();
   for (std::size_t j = 0; j < n_outputs_; ++j) {
-    const SqrtRls& full = full_[j];
+    const NestedRls& reg = regressions_[j];
     LoopStats& loop = loops_[j];
-    const double rss_full = full.rss();
-    loop.sigma1 = full.rss_prefix(1 + na_) / sum_w_;
+    const double rss_full = reg.rss_full();
+    const double rss_ar = reg.rss_prefix_only();
+    loop.sigma1 = rss_ar / sum_w_;
     loop.sigma_full = rss_full / sum_w_;
-    loop.residual_variance = full.rss_prefix(1) / sum_w_;
-    loop.lr_joint = scale_full * std::log(full.rss_prefix(1 + na_) / rss_full);
+    loop.residual_variance = reg.rss_head(1) / sum_w_;
+    loop.lr_joint = scale_full * std::log(rss_ar / rss_full);
+    // The AR parts of every pairwise model, for gamma, in one solve.
+    const Eigen::MatrixXd* pair_prefix = n_inverse_ar_[j] ? &reg.solve_pairs_prefix() : nullptr;
     bool any_channel = false;
     for (std::size_t i = 0; i < n_inputs_; ++i) {
       ChannelStats& c = channels_[j * n_inputs_ + i];
-      const double rss_without = full.rss_without_wald(1 + na_ + i * nb_, nb_, scratch_);
-      c.f_conditional = std::log(rss_without / rss_full);
+      c.f_conditional = std::log(reg.rss_without_block(i, scratch_) / rss_full);
       c.lr_conditional = scale_full * c.f_conditional;
-
-      const SqrtRls& pair = pair_model(j, i);
-      const double rss_pair = pair.rss_prefix(p_pair);
-      c.f_pairwise = std::log(pair.rss_prefix(1 + na_) / rss_pair);
+      c.f_pairwise = std::log(reg.rss_pair_prefix_only(i) / reg.rss_pair(i));
       c.lr_pairwise = scale_pair * c.f_pairwise;
 
       if (n_inverse_ar_[j]) {
         // gamma = ||g_hat - g_N||^2 / ||[1, -g_N]||^2: the distance between
         // the fitted AR part and that of N^-1, relative to the whole N^-1
         // polynomial (leading 1 included), so a white N (g_N = 0) is fine.
-        pair.solve_prefix(p_pair, pair_coef_);
         const auto& g_n = *n_inverse_ar_[j];
-        const double dist = (pair_coef_.segment(1, static_cast<Eigen::Index>(na_)) - g_n).squaredNorm();
+        const auto g_hat = pair_prefix->col(static_cast<Eigen::Index>(i)).segment(1, static_cast<Eigen::Index>(na_));
+        const double dist = (g_hat - g_n).squaredNorm();
         c.gamma = dist / (1.0 + g_n.squaredNorm());
       }
       if (testing) update_hysteresis(c, c.lr_conditional, lr_raise_, lr_clear_, c.alarm);
@@ -333,12 +307,6 @@ void GrangerMonitor::update_statistics() noexcept {
   }
 }
 
-const SqrtRls& GrangerMonitor::pair_model(std::size_t output, std::size_t input) const noexcept {
-  // Its first 1 + na + nb regressors are the pairwise model's.
-  if (input == 0) return full_[output];
-  return pairwise_[output * (n_inputs_ - 1) + input - 1];
-}
-
 template <typename Stats>
 void GrangerMonitor::update_hysteresis(Stats& s, double lr, double raise, double clear, bool& alarm) noexcept {
   if (lr > raise) {
@@ -356,13 +324,13 @@ void GrangerMonitor::update_hysteresis(Stats& s, double lr, double raise, double
 }
 
 void GrangerMonitor::full_coefficients(std::size_t output, Eigen::Ref<Eigen::VectorXd> out) const noexcept {
-  full_[output].solve_prefix(n_regressors(), out);
+  regressions_[output].solve_full(out);
 }
 
 void GrangerMonitor::pairwise_ar_coefficients(std::size_t output, std::size_t input,
                                               Eigen::Ref<Eigen::VectorXd> out) const noexcept {
-  // out: na values. Solve the pairwise model into scratch, copy the AR part.
-  pair_model(output, input).solve_prefix(1 + na_ + nb_, pair_coef_);
+  // out: na values, the AR part of [1, AR] of the pairwise model.
+  regressions_[output].solve_pair_prefix(input, pair_coef_);
   out.head(static_cast<Eigen::Index>(na_)) = pair_coef_.segment(1, static_cast<Eigen::Index>(na_));
 }
 

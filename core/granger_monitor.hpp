@@ -9,13 +9,13 @@
 // u_i(k-1..k-nb). A slow process has responses far longer than nb samples;
 // with a near its dominant pole the same nb regressors cover them, which is
 // what makes small, concealed mismatches detectable in a few thousand samples.
-// by square-root recursive least squares with exponential forgetting (see
-// sqrt_rls.hpp). From that one factor per output come
+// The regressions are fitted by square-root recursive least squares with
+// exponential forgetting, one shared update per output (nested_rls.hpp):
+// the rows of [1, AR] are common to all of an output's models. From it come
 //   * the AR-only residual variance Sigma1 and the full-model variance,
 //   * the conditional Granger index of every input (all other inputs kept),
 //     F_c(u_i -> d~_j) = ln(RSS without u_i / RSS full),
-// and from one small factor per (output, input) pair, [1, AR, u_i] (for the
-// first input a prefix of the full model's factor, so no extra one),
+// and from its pairwise models [1, AR, u_i] (a small extra factor each),
 //   * the paper's pairwise index F(u_i -> d~_j) = ln(Sigma1 / Sigma2),
 //   * the AR coefficients the paper compares with N^-1: gamma(u_i -> d~_j).
 //
@@ -53,7 +53,7 @@
 
 #include <Eigen/Dense>
 
-#include "core/sqrt_rls.hpp"
+#include "core/nested_rls.hpp"
 #include "core/transfer_function.hpp"
 
 namespace mpm {
@@ -182,9 +182,6 @@ class GrangerMonitor {
   template <typename Stats>
   void update_hysteresis(Stats& s, double lr, double raise, double clear, bool& alarm) noexcept;
   void update_divergence(const double* residual) noexcept;
-  // The factor whose first 1 + na + nb regressors are [1, AR, u_i] of output
-  // j: the full model's for the first input, else a pairwise one.
-  const SqrtRls& pair_model(std::size_t output, std::size_t input) const noexcept;
 
   MonitorSettings settings_;
   std::size_t n_inputs_;
@@ -207,10 +204,11 @@ class GrangerMonitor {
   Eigen::VectorXd input_ref_;      // input level at (re)start: the basis sees
                                    // u - input_ref_, so its zero state is at rest
 
-  std::vector<SqrtRls> full_;      // one per output
-  std::vector<SqrtRls> pairwise_;  // output-major, one per (output, input > 0)
-  Eigen::VectorXd coef_;           // scratch coefficients (full)
-  mutable Eigen::VectorXd pair_coef_;  // scratch coefficients (pairwise)
+  // One per output: the full model [1, AR, u_1 .. u_m] and the pairwise
+  // models [1, AR, u_i] in one shared update (nested_rls.hpp).
+  std::vector<NestedRls> regressions_;
+  std::vector<NestedRls*> regression_ptrs_;  // the same, for update_staged
+  mutable Eigen::VectorXd pair_coef_;  // scratch: [1, AR] coefficients of a pairwise model
   SqrtRls::Matrix scratch_;        // scratch for conditional RSS
 
   std::vector<std::optional<Eigen::VectorXd>> n_inverse_ar_;

@@ -1,71 +1,15 @@
 #include "core/sqrt_rls.hpp"
 
+#include "core/givens.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 namespace mpm {
-namespace {
-
-// A kept-alive prior row every K samples: K as large as this (fewer
-// rotation chains), but a direction's prior may decay by at most kPriorDip
-// between two refreshes (p K samples apart).
-constexpr int kMaxPriorPeriod = 10;
-constexpr double kPriorDip = 0.25;
-
-struct Rotation {
-  double c = 1.0;
-  double s = 0.0;
-};
-
-// Rotates the pivot row a, scaled by `scale` first, against row b so that
-// b[first] becomes 0; columns [first, end) of both rows are updated and
-// a[first] stays >= 0. Returns the rotation (identity when b[first] == 0).
-inline Rotation rotate(double* __restrict a, double* __restrict b, std::size_t first, std::size_t end,
-                       double scale) noexcept {
-  const double x = scale * a[first];
-  const double y = b[first];
-  if (y == 0.0) {
-    if (scale != 1.0)
-      for (std::size_t j = first; j < end; ++j) a[j] *= scale;
-    return {};
-  }
-  const double inv = 1.0 / std::sqrt(x * x + y * y);  // one division, two products
-  const double c = x * inv;
-  const double s = y * inv;
-  const double cs = c * scale;
-  const double ss = s * scale;
-  a[first] = x * c + y * s;
-  b[first] = 0.0;
-  for (std::size_t j = first + 1; j < end; ++j) {
-    const double aj = a[j];
-    const double bj = b[j];
-    a[j] = cs * aj + s * bj;
-    b[j] = c * bj - ss * aj;
-  }
-  return {c, s};
-}
-
-// The same rotation on the inverse's rows: [a / scale; b] (columns [0, end)).
-inline void rotate_inverse(double* __restrict a, double* __restrict b, std::size_t end, Rotation rot,
-                           double inv_scale) noexcept {
-  const double ci = rot.c * inv_scale;
-  const double si = rot.s * inv_scale;
-  for (std::size_t j = 0; j < end; ++j) {
-    const double aj = a[j];
-    const double bj = b[j];
-    a[j] = ci * aj + rot.s * bj;
-    b[j] = rot.c * bj - si * aj;
-  }
-}
-
-int prior_period(std::size_t p, double lambda) {
-  if (lambda >= 1.0) return 1;
-  const double k = std::floor(std::log(kPriorDip) / (static_cast<double>(p) * std::log(lambda)));
-  return static_cast<int>(std::clamp(k, 1.0, static_cast<double>(kMaxPriorPeriod)));
-}
-
-}  // namespace
+using givens::Rotation;
+using givens::rotate;
+using givens::rotate_inverse;
 
 SqrtRls::SqrtRls(std::size_t n_regressors, double forgetting, double regularization, bool track_inverse)
     : p_(n_regressors),
@@ -77,8 +21,8 @@ SqrtRls::SqrtRls(std::size_t n_regressors, double forgetting, double regularizat
   if (n_regressors == 0) throw std::invalid_argument("SqrtRls: need at least one regressor");
   if (!(forgetting > 0.0 && forgetting <= 1.0)) throw std::invalid_argument("SqrtRls: forgetting must be in (0, 1]");
   if (!(regularization > 0.0)) throw std::invalid_argument("SqrtRls: regularization must be > 0");
-  prior_period_ = prior_period(p_, lambda_);
-  prior_weight_ = std::sqrt(static_cast<double>(p_) * prior_period_ * (1.0 - lambda_) * delta_);
+  prior_period_ = givens::prior_period(p_, lambda_);
+  prior_weight_ = givens::prior_weight(p_, prior_period_, lambda_, delta_);
   const auto n = static_cast<Eigen::Index>(p_ + 1);
   r_.resize(n, n);
   work_.resize(n);
@@ -128,6 +72,12 @@ void SqrtRls::update(const double* x, double y) noexcept {
   work_[static_cast<Eigen::Index>(p_)] = y;
   SqrtRls* self = this;
   update_staged(&self, 1);
+}
+
+void SqrtRls::add_row(const double* x, double y) noexcept {
+  std::copy(x, x + p_, work_.data());
+  work_[static_cast<Eigen::Index>(p_)] = y;
+  absorb(0, 1.0);
 }
 
 void SqrtRls::update_staged(SqrtRls* const* models, std::size_t count) noexcept {

@@ -52,11 +52,14 @@ class SqrtRls {
 
   // Real-time safe. x: n_regressors values, y: target.
   void update(const double* x, double y) noexcept;
-  // The same in two steps, for updating independent models together: write
-  // x then y into staged_row() (n_regressors + 1 values) of each model, then
-  // update_staged() interleaves their rotations, so the latencies of their
-  // square roots and divisions overlap. Each model ends exactly as if updated
-  // alone. Real-time safe.
+  // Absorbs one row with weight 1 and no forgetting (a prior row, or the
+  // part of one that a shared factor passes on). Real-time safe.
+  void add_row(const double* x, double y) noexcept;
+  // The same as update() in two steps, for updating independent models
+  // together: write x then y into staged_row() (n_regressors + 1 values) of
+  // each model, then update_staged() interleaves their rotations, so the
+  // latencies of their square roots and divisions overlap. Each model ends
+  // exactly as if updated alone. Real-time safe.
   double* staged_row() noexcept { return work_.data(); }
   static void update_staged(SqrtRls* const* models, std::size_t count) noexcept;
 
