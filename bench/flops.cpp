@@ -105,6 +105,49 @@ double rss_without_wald_flops(std::size_t p, std::size_t first, std::size_t coun
   return f + rss_prefix_flops(p, p) + 1.0;  // rss() + quad
 }
 
+namespace {
+
+// The Cholesky of a count x count block and the forward solve of g
+// (SqrtRls::wald_quadratic): row a: for each b <= a a dot product of b
+// terms (2b) and a division or the square root; the solve: 2a, a division,
+// and quad += t^2 (2).
+double wald_quadratic_flops(std::size_t count) {
+  double f = 0.0;
+  for (std::size_t a = 0; a < count; ++a) {
+    for (std::size_t b = 0; b <= a; ++b) f += 2.0 * d(b) + 1.0;
+    f += 2.0 * d(a) + 3.0;
+  }
+  return f;
+}
+
+}  // namespace
+
+double tracked_blocks_update_flops(std::size_t p, std::size_t block, double lambda) {
+  // Every absorbed row (the data row, and 1/K prior rows): S_b = growth S_b
+  // - v_b v_b^T over each block's lower triangle (3 per entry); the data row
+  // also recomputes one block from L (rows k >= b0: per nonzero r of the
+  // row, 2 (r + 1)), averaged over the round-robin b0.
+  const double blocks = d(p / block);
+  const double triangle = d(block) * d(block + 1) / 2.0;
+  const double per_row = blocks * 3.0 * triangle;
+  double resync = 0.0;
+  for (std::size_t b0 = 0; b0 < p; b0 += block)
+    for (std::size_t k = b0; k < p; ++k)
+      for (std::size_t r = 0; r < std::min(block, k - b0 + 1); ++r) resync += 2.0 * d(r + 1);
+  resync /= blocks;
+  const double priors = lambda < 1.0 ? 1.0 / static_cast<double>(prior_refresh_period(p, lambda)) : 0.0;
+  return per_row * (1.0 + priors) + resync;
+}
+
+double tracked_block_wald_flops(std::size_t p, std::size_t count) {
+  // L^T z once per update, shared by the blocks (rows padded to 4 lanes, 2
+  // per entry), counted here once per block's share; then the block's
+  // Cholesky and solve, and rss() + quad.
+  double coef = 0.0;
+  for (std::size_t r = 0; r < p; ++r) coef += 2.0 * d((r + 4) / 4 * 4);
+  return coef / d(p / count) + wald_quadratic_flops(count) + rss_prefix_flops(p, p) + 1.0;
+}
+
 double solve_prefix_flops(std::size_t k) {
   // Coefficient i: reciprocal of the diagonal and a product (2), then i
   // multiply-subtracts into the coefficients above it (2i).
@@ -175,6 +218,7 @@ MonitorFlops monitor_flops(std::size_t inputs, std::size_t outputs, const Monito
   // (Each trapezoid rotation also turns the tracked R_AA^-T's row i.)
   for (std::size_t i = 0; i < a; ++i) shared += rotation_flops(cols - 1 - i) + inverse_rotation_flops(i + 1, false);
   shared += sqrt_rls_update_flops(p_lower, lambda, wald);
+  if (wald) shared += tracked_blocks_update_flops(p_lower, nb, lambda);
   if (lambda < 1.0) {
     double prior = 0.0;
     for (std::size_t r = 0; r < a; ++r)
@@ -193,8 +237,8 @@ MonitorFlops monitor_flops(std::size_t inputs, std::size_t outputs, const Monito
     const std::size_t first = i * nb;
     if (inputs == 1) conditional += rss_prefix_flops(p_lower, 0);
     else if (inputs == 2) conditional += i == 0 ? rss_prefix_flops(nb, nb) : rss_prefix_flops(p_lower, nb);
-    else conditional += wald || first + nb >= p_lower ? rss_without_wald_flops(p_lower, first, nb)
-                                                      : rss_without_flops(p_lower, first, nb);
+    else if (first + nb >= p_lower) conditional += rss_without_wald_flops(p_lower, first, nb);  // trailing: prefix sum
+    else conditional += wald ? tracked_block_wald_flops(p_lower, nb) : rss_without_flops(p_lower, first, nb);
   }
   f.conditional = n_out * conditional;
   // absorb_sample's weights (sum_w 2, sum_w2 3, n_eq 2) and update_statistics'

@@ -38,6 +38,10 @@ double rss_without_flops(std::size_t p, std::size_t first, std::size_t count);
 // Flops of SqrtRls::rss_without_wald(first, count) with the inverse tracked
 // (Gram matrix of the block's columns of R^-T, Cholesky, forward solve).
 double rss_without_wald_flops(std::size_t p, std::size_t first, std::size_t count);
+// With the block covariances tracked (SqrtRls wald_block): their per-update
+// upkeep, and one block's rss_without_wald.
+double tracked_blocks_update_flops(std::size_t p, std::size_t block, double lambda);
+double tracked_block_wald_flops(std::size_t p, std::size_t count);
 // Flops of SqrtRls::solve_prefix(k).
 double solve_prefix_flops(std::size_t k);
 

@@ -15,44 +15,93 @@ struct Rotation {
   double s = 0.0;
 };
 
+// Rows of the factors are stored padded to a whole number of kLanes values
+// (zeros), so the rotations below run over whole vectors: no remainder loop,
+// whose set-up would cost as much as the work on rows this short.
+constexpr std::size_t kLanes = 4;
+constexpr std::size_t padded(std::size_t n) noexcept { return (n + kLanes - 1) / kLanes * kLanes; }
+
+// Four doubles (GCC/Clang vector extension: AVX when compiled for it, else
+// two SSE2 halves). Loads and stores are unaligned.
+typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
+inline Lanes load(const double* p) noexcept {
+  Lanes v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store(double* p, Lanes v) noexcept { __builtin_memcpy(p, &v, sizeof v); }
+typedef long long LaneMask __attribute__((vector_size(kLanes * sizeof(long long))));
+constexpr LaneMask kLaneIndex = {0, 1, 2, 3};
+
 // Rotates the pivot row a, scaled by `scale` first, against row b so that
 // b[first] becomes 0; columns [first, end) of both rows are updated and
 // a[first] stays >= 0. Returns the rotation (identity when b[first] == 0).
+// `end` is a padded width. Columns before `first` in the same block of
+// lanes are rotated too: they must be zero in both rows (below the diagonal
+// of a triangular factor, and already eliminated from the row being
+// absorbed), and stay zero.
 inline Rotation rotate(double* __restrict a, double* __restrict b, std::size_t first, std::size_t end,
                        double scale) noexcept {
   const double x = scale * a[first];
   const double y = b[first];
+  const std::size_t begin = first / kLanes * kLanes;
   if (y == 0.0) {
     if (scale != 1.0)
-      for (std::size_t j = first; j < end; ++j) a[j] *= scale;
+      for (std::size_t j = begin; j < end; j += kLanes) store(a + j, load(a + j) * scale);
     return {};
   }
+  // The next rotation waits on b[first + 1] only: computed as
+  // (x b - y scale a) / r, its products do not wait for the square root and
+  // the division, so one product follows them on the critical path instead
+  // of three (c, s scale, then the update).
+  const std::size_t next = first + 1;
+  const bool next_in_block = next - begin < kLanes;
+  const double x_next = next_in_block ? x * b[next] : 0.0;
+  const double y_next = next_in_block ? y * (scale * a[next]) : 0.0;
   const double inv = 1.0 / std::sqrt(x * x + y * y);  // one division, two products
+  const double b_next = (x_next - y_next) * inv;
   const double c = x * inv;
   const double s = y * inv;
   const double cs = c * scale;
   const double ss = s * scale;
-  a[first] = x * c + y * s;
-  b[first] = 0.0;
-  for (std::size_t j = first + 1; j < end; ++j) {
-    const double aj = a[j];
-    const double bj = b[j];
-    a[j] = cs * aj + s * bj;
-    b[j] = c * bj - ss * aj;
+  const double pivot = x * c + y * s;
+  // The first block: the pivot, the eliminated zero and b[first + 1] set by
+  // lane masks, not by scalar stores after a vector store (a later vector
+  // load of a block written partly by scalar stores cannot be forwarded from
+  // the store buffer and stalls).
+  {
+    const Lanes a0 = load(a + begin);
+    const Lanes b0 = load(b + begin);
+    const LaneMask at_first = kLaneIndex == static_cast<long long>(first - begin);
+    const LaneMask at_next = kLaneIndex == static_cast<long long>(next - begin);
+    const Lanes zero = {0.0, 0.0, 0.0, 0.0};
+    const Lanes a1 = at_first ? pivot + zero : cs * a0 + s * b0;
+    Lanes b1 = at_first ? zero : c * b0 - ss * a0;
+    b1 = at_next ? b_next + zero : b1;
+    store(a + begin, a1);
+    store(b + begin, b1);
+  }
+  for (std::size_t j = begin + kLanes; j < end; j += kLanes) {
+    const Lanes aj = load(a + j);
+    const Lanes bj = load(b + j);
+    store(a + j, cs * aj + s * bj);
+    store(b + j, c * bj - ss * aj);
   }
   return {c, s};
 }
 
-// The same rotation on the inverse's rows: [a / scale; b] (columns [0, end)).
+// The same rotation on the inverse's rows: [a / scale; b], columns [0, end)
+// rounded up to whole lanes (zeros past `end` in both rows, kept zero).
 inline void rotate_inverse(double* __restrict a, double* __restrict b, std::size_t end, Rotation rot,
                            double inv_scale) noexcept {
   const double ci = rot.c * inv_scale;
   const double si = rot.s * inv_scale;
-  for (std::size_t j = 0; j < end; ++j) {
-    const double aj = a[j];
-    const double bj = b[j];
-    a[j] = ci * aj + rot.s * bj;
-    b[j] = rot.c * bj - si * aj;
+  const std::size_t stop = padded(end);
+  for (std::size_t j = 0; j < stop; j += kLanes) {
+    const Lanes aj = load(a + j);
+    const Lanes bj = load(b + j);
+    store(a + j, ci * aj + rot.s * bj);
+    store(b + j, rot.c * bj - si * aj);
   }
 }
 

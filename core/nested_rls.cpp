@@ -31,12 +31,12 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
   if (!(regularization > 0.0)) throw std::invalid_argument("NestedRls: regularization must be > 0");
   prior_period_ = givens::prior_period(a_, forgetting);
   prior_weight_ = givens::prior_weight(a_, prior_period_, forgetting, delta_);
-  top_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(cols_));
-  lower_ = SqrtRls(m_ * nb_, forgetting, regularization, track_inverse);
+  top_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(givens::padded(cols_)));
+  lower_ = SqrtRls(m_ * nb_, forgetting, regularization, track_inverse, track_inverse ? nb_ : 0);
   pairs_.assign(m_ - 1, SqrtRls(nb_, forgetting, regularization));
-  row_.resize(static_cast<Eigen::Index>(cols_));
-  top_inv_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(a_));
-  row_inv_.resize(static_cast<Eigen::Index>(a_));
+  row_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(givens::padded(cols_)));
+  top_inv_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(givens::padded(a_)));
+  row_inv_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(givens::padded(a_)));
   pair_rhs_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(m_));
   coef_b_.resize(static_cast<Eigen::Index>(m_ * nb_));
   pair_prefix_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(m_));
@@ -64,7 +64,7 @@ void NestedRls::absorb_top(std::size_t first, double scale) noexcept {
 
 void NestedRls::rotate_top_row(std::size_t i, double scale) noexcept {
   const auto ii = static_cast<Eigen::Index>(i);
-  const givens::Rotation rot = givens::rotate(top_.row(ii).data(), row_.data(), i, cols_, scale);
+  const givens::Rotation rot = givens::rotate(top_.row(ii).data(), row_.data(), i, givens::padded(cols_), scale);
   const double inv_scale = scale == sqrt_lambda_ ? inv_sqrt_lambda_ : 1.0 / scale;
   givens::rotate_inverse(top_inv_.row(ii).data(), row_inv_.data(), i + 1, rot, inv_scale);
 }
@@ -193,19 +193,14 @@ const Eigen::MatrixXd& NestedRls::solve_pairs_prefix() const noexcept {
     if (i == 0) lower_.solve_prefix(nb_, beta_b);
     else pairs_[i - 1].solve_prefix(nb_, beta_b);
   }
-  for (std::size_t r = 0; r < a_; ++r) {
-    const double* row = top_.row(static_cast<Eigen::Index>(r)).data() + a_;
-    const double y = top_(static_cast<Eigen::Index>(r), target);
-    for (std::size_t i = 0; i < m_; ++i) {
-      const double* rb = row + i * nb_;
-      const double* bb = coef_b_.data() + i * nb_;
-      double v = y;
-      for (std::size_t c = 0; c < nb_; ++c) v -= rb[c] * bb[c];
-      pair_rhs_(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(i)) = v;
-    }
+  const auto a = static_cast<Eigen::Index>(a_);
+  const auto nb = static_cast<Eigen::Index>(nb_);
+  for (std::size_t i = 0; i < m_; ++i) {
+    const auto ii = static_cast<Eigen::Index>(i);
+    pair_rhs_.col(ii) = top_.col(target);
+    pair_rhs_.col(ii).noalias() -= top_.block(0, a + ii * nb, a, nb) * coef_b_.segment(ii * nb, nb);
   }
-  for (std::size_t i = 0; i < m_; ++i)
-    apply_top_inverse(pair_rhs_.col(static_cast<Eigen::Index>(i)).data(), pair_prefix_.col(static_cast<Eigen::Index>(i)).data());
+  pair_prefix_.noalias() = top_inv_.leftCols(a).transpose() * pair_rhs_;
   return pair_prefix_;
 }
 

@@ -11,7 +11,8 @@ using givens::Rotation;
 using givens::rotate;
 using givens::rotate_inverse;
 
-SqrtRls::SqrtRls(std::size_t n_regressors, double forgetting, double regularization, bool track_inverse)
+SqrtRls::SqrtRls(std::size_t n_regressors, double forgetting, double regularization, bool track_inverse,
+                 std::size_t wald_block)
     : p_(n_regressors),
       lambda_(forgetting),
       sqrt_lambda_(std::sqrt(forgetting)),
@@ -21,14 +22,23 @@ SqrtRls::SqrtRls(std::size_t n_regressors, double forgetting, double regularizat
   if (n_regressors == 0) throw std::invalid_argument("SqrtRls: need at least one regressor");
   if (!(forgetting > 0.0 && forgetting <= 1.0)) throw std::invalid_argument("SqrtRls: forgetting must be in (0, 1]");
   if (!(regularization > 0.0)) throw std::invalid_argument("SqrtRls: regularization must be > 0");
+  if (wald_block > 0 && (!track_inverse || n_regressors % wald_block != 0))
+    throw std::invalid_argument("SqrtRls: block covariances need the tracked inverse and whole blocks");
+  wald_block_ = wald_block;
   prior_period_ = givens::prior_period(p_, lambda_);
   prior_weight_ = givens::prior_weight(p_, prior_period_, lambda_, delta_);
   const auto n = static_cast<Eigen::Index>(p_ + 1);
-  r_.resize(n, n);
-  work_.resize(n);
+  const auto width = static_cast<Eigen::Index>(givens::padded(p_ + 1));
+  r_.resize(n, width);
+  work_ = Eigen::VectorXd::Zero(width);
   if (track_inverse_) {
-    linv_.resize(n - 1, n - 1);
-    work_inv_.resize(n - 1);
+    const auto inv_width = static_cast<Eigen::Index>(givens::padded(p_));
+    linv_.resize(n - 1, inv_width);
+    work_inv_ = Eigen::VectorXd::Zero(inv_width);
+  }
+  if (wald_block_ > 0) {
+    block_cov_.resize(n - 1, static_cast<Eigen::Index>(wald_block_));
+    coef_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(givens::padded(p_)));
   }
   reset();
 }
@@ -41,26 +51,92 @@ void SqrtRls::reset() noexcept {
     for (std::size_t i = 0; i < p_; ++i)
       linv_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = 1.0 / std::sqrt(delta_);
   }
+  if (wald_block_ > 0) {
+    // P = I / delta: every block's covariance starts as a scaled identity.
+    block_cov_.setZero();
+    for (std::size_t i = 0; i < p_; ++i)
+      block_cov_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i % wald_block_)) = 1.0 / delta_;
+  }
   next_prior_row_ = 0;
   since_prior_ = 0;
+  next_resync_ = 0;
+  ++changes_;
 }
 
 void SqrtRls::absorb(std::size_t first, double scale) noexcept {
   if (track_inverse_) return absorb_with_inverse(first, scale);
   const std::size_t n = p_ + 1;
+  const std::size_t width = givens::padded(n);
   double* w = work_.data();
-  for (std::size_t i = first; i < n; ++i) rotate(r_.row(static_cast<Eigen::Index>(i)).data(), w, i, n, scale);
+  for (std::size_t i = first; i < n; ++i) rotate(r_.row(static_cast<Eigen::Index>(i)).data(), w, i, width, scale);
 }
 
 void SqrtRls::absorb_with_inverse(std::size_t first, double scale) noexcept {
   std::fill(work_inv_.data(), work_inv_.data() + p_, 0.0);
   for (std::size_t i = first; i <= p_; ++i) absorb_row(i, scale);
+  downdate_block_covariances(1.0);  // only rows without forgetting come here
+}
+
+void SqrtRls::downdate_block_covariances(double growth) noexcept {
+  ++changes_;
+  if (wald_block_ == 0) return;
+  // Rotations preserve the Gram matrix of the columns of [L / sqrt(lambda);
+  // 0] (rows absorbed without forgetting: [L; 0]), which ends as [L'; v^T]:
+  //   P / lambda = P' + v v^T,  P = (R^T R)^-1 = L^T L.
+  // So each diagonal block of P' is the old one, grown by 1 / lambda, less
+  // v_b v_b^T: O(p nb) instead of O(p^2 nb) from L. Lower triangles only.
+  const double* v = work_inv_.data();
+  const std::size_t nb = wald_block_;
+  for (std::size_t b0 = 0; b0 < p_; b0 += nb) {
+    for (std::size_t r = 0; r < nb; ++r) {
+      double* srow = block_cov_.row(static_cast<Eigen::Index>(b0 + r)).data();
+      const double vr = v[b0 + r];
+      for (std::size_t c = 0; c <= r; ++c) srow[c] = growth * srow[c] - vr * v[b0 + c];
+    }
+  }
+}
+
+void SqrtRls::resync_block_covariance(std::size_t b0) noexcept {
+  // Rounding in the downdates is not self-correcting: one block a sample is
+  // recomputed from L, S_b = M^T M with M = L[b0:p, b] (rows above b0 are
+  // zero in these columns), so each block is exact again every p / nb samples.
+  const std::size_t nb = wald_block_;
+  for (std::size_t r = 0; r < nb; ++r) {
+    double* srow = block_cov_.row(static_cast<Eigen::Index>(b0 + r)).data();
+    std::fill(srow, srow + nb, 0.0);
+  }
+  for (std::size_t k = b0; k < p_; ++k) {
+    const double* v = linv_.row(static_cast<Eigen::Index>(k)).data() + b0;
+    const std::size_t len = std::min(nb, k - b0 + 1);  // lower triangular
+    for (std::size_t r = 0; r < len; ++r) {
+      double* srow = block_cov_.row(static_cast<Eigen::Index>(b0 + r)).data();
+      const double vr = v[r];
+      for (std::size_t c = 0; c <= r; ++c) srow[c] += vr * v[c];
+    }
+  }
+}
+
+const double* SqrtRls::coefficients_from_inverse() const noexcept {
+  // beta = R^-1 z = L^T z, as AXPYs of L's rows (no dependency chain);
+  // computed once per change of the factor, shared by all blocks' tests.
+  if (coef_stamp_ == changes_) return coef_.data();
+  coef_.setZero();
+  double* beta = coef_.data();
+  const auto target = static_cast<Eigen::Index>(p_);
+  for (std::size_t r = 0; r < p_; ++r) {
+    const double* l = linv_.row(static_cast<Eigen::Index>(r)).data();
+    const double z = r_(static_cast<Eigen::Index>(r), target);
+    const std::size_t stop = givens::padded(r + 1);  // zeros past the diagonal
+    for (std::size_t k = 0; k < stop; ++k) beta[k] += z * l[k];
+  }
+  coef_stamp_ = changes_;
+  return beta;
 }
 
 void SqrtRls::absorb_row(std::size_t i, double scale) noexcept {
   const std::size_t n = p_ + 1;
   const auto ii = static_cast<Eigen::Index>(i);
-  const Rotation rot = rotate(r_.row(ii).data(), work_.data(), i, n, scale);
+  const Rotation rot = rotate(r_.row(ii).data(), work_.data(), i, givens::padded(n), scale);
   if (track_inverse_ && i < p_) {
     const double inv_scale = scale == sqrt_lambda_ ? inv_sqrt_lambda_ : 1.0 / scale;
     rotate_inverse(linv_.row(ii).data(), work_inv_.data(), i + 1, rot, inv_scale);
@@ -92,7 +168,15 @@ void SqrtRls::update_staged(SqrtRls* const* models, std::size_t count) noexcept 
   for (std::size_t i = 0; i < rows; ++i)
     for (std::size_t m = 0; m < count; ++m)
       if (i <= models[m]->p_) models[m]->absorb_row(i, models[m]->sqrt_lambda_);  // forgetting folded in
-  for (std::size_t m = 0; m < count; ++m) models[m]->refresh_prior();
+  for (std::size_t m = 0; m < count; ++m) {
+    SqrtRls& s = *models[m];
+    s.downdate_block_covariances(1.0 / s.lambda_);
+    if (s.wald_block_ > 0) {
+      s.resync_block_covariance(s.next_resync_);
+      s.next_resync_ = (s.next_resync_ + s.wald_block_) % s.p_;
+    }
+    s.refresh_prior();
+  }
 }
 
 void SqrtRls::refresh_prior() noexcept {
@@ -178,6 +262,18 @@ double SqrtRls::rss_without_wald(std::size_t first, std::size_t count, Matrix& s
   if (count == 0) return rss();
   if (first + count >= p_) return rss_prefix(first);  // trailing block: exact and free
   if (!track_inverse_) return rss_without(first, count, scratch);
+  if (wald_block_ > 0 && count == wald_block_ && first % wald_block_ == 0) {
+    // The block's covariance is tracked; beta_b from the shared L^T z.
+    const double* beta = coefficients_from_inverse();
+    double* g = scratch.row(static_cast<Eigen::Index>(count)).data();
+    for (std::size_t a = 0; a < count; ++a) {
+      g[a] = beta[first + a];
+      const double* src = block_cov_.row(static_cast<Eigen::Index>(first + a)).data();
+      std::copy(src, src + a + 1, scratch.row(static_cast<Eigen::Index>(a)).data());
+    }
+    const double quad = wald_quadratic(scratch, count);
+    return quad >= 0.0 ? rss() + quad : rss_without(first, count, scratch);
+  }
   // With M = L[first:p, b] (L = R^-T lower triangular, so rows above `first`
   // are zero in these columns) and z = R[first:p, target]:
   //   [(R^T R)^-1]_bb = M^T M = S,  beta_b = M^T z = g,
@@ -201,8 +297,15 @@ double SqrtRls::rss_without_wald(std::size_t first, std::size_t count, Matrix& s
       for (std::size_t c = 0; c <= a; ++c) srow[c] += va * v[c];
     }
   }
-  // Cholesky S = C C^T in place (lower triangle), forward solve C t = g;
-  // g^T S^-1 g = |t|^2.
+  const double quad = wald_quadratic(scratch, count);
+  return quad >= 0.0 ? rss() + quad : rss_without(first, count, scratch);
+}
+
+double SqrtRls::wald_quadratic(Matrix& scratch, std::size_t count) noexcept {
+  // S in the lower triangle of scratch rows [0, count), g in row `count`.
+  // Cholesky S = C C^T in place, forward solve C t = g; g^T S^-1 g = |t|^2.
+  // -1 when S is not positive definite.
+  double* g = scratch.row(static_cast<Eigen::Index>(count)).data();
   double quad = 0.0;
   for (std::size_t a = 0; a < count; ++a) {
     double* ca = scratch.row(static_cast<Eigen::Index>(a)).data();
@@ -213,7 +316,7 @@ double SqrtRls::rss_without_wald(std::size_t first, std::size_t count, Matrix& s
       if (b < a) {
         ca[b] = sum / cb[b];
       } else {
-        if (!(sum > 0.0)) return rss_without(first, count, scratch);  // not positive definite
+        if (!(sum > 0.0)) return -1.0;  // not positive definite
         ca[a] = std::sqrt(sum);
       }
     }
@@ -222,7 +325,7 @@ double SqrtRls::rss_without_wald(std::size_t first, std::size_t count, Matrix& s
     g[a] = t / ca[a];
     quad += g[a] * g[a];
   }
-  return rss() + quad;
+  return quad;
 }
 
 void SqrtRls::solve_prefix(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const noexcept {

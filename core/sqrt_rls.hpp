@@ -33,7 +33,9 @@
 // squares with a ridge of `regularization` (negligible at 1e-9).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
+#include <cstdint>
 
 #include <Eigen/Dense>
 
@@ -47,8 +49,13 @@ class SqrtRls {
   SqrtRls() = default;
   // n_regressors >= 1, forgetting in (0, 1], regularization > 0.
   // track_inverse: also carry R^-T for rss_without_wald.
+  // wald_block > 0 (needs track_inverse, n_regressors a multiple of it):
+  // also track the diagonal blocks of (R^T R)^-1 for regressor blocks
+  // [k wald_block, (k + 1) wald_block), so rss_without_wald of such a block
+  // costs O(wald_block^3) instead of O(p wald_block^2) (see
+  // downdate_block_covariances in the .cpp).
   SqrtRls(std::size_t n_regressors, double forgetting, double regularization = 1e-9,
-          bool track_inverse = false);
+          bool track_inverse = false, std::size_t wald_block = 0);
 
   // Real-time safe. x: n_regressors values, y: target.
   void update(const double* x, double y) noexcept;
@@ -79,10 +86,12 @@ class SqrtRls {
   // out.size() >= k; writes out[0..k). Real-time safe.
   void solve_prefix(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const noexcept;
   // The factor, (p+1) x (p+1) upper triangular; last column = target.
-  const Matrix& factor() const noexcept { return r_; }
+  Eigen::Ref<const Matrix> factor() const noexcept { return r_.leftCols(static_cast<Eigen::Index>(p_ + 1)); }
   // The tracked R^-T of the regressor part, p x p lower triangular (empty
   // unless tracks_inverse()).
-  const Matrix& inverse_factor() const noexcept { return linv_; }
+  Eigen::Ref<const Matrix> inverse_factor() const noexcept {
+    return linv_.leftCols(std::min(linv_.cols(), static_cast<Eigen::Index>(p_)));
+  }
   // Back to the prior.
   void reset() noexcept;
 
@@ -97,16 +106,33 @@ class SqrtRls {
   int since_prior_ = 0;
   double prior_weight_ = 0.0;   // sqrt(p K (1 - lambda) delta)
   std::size_t next_prior_row_ = 0;
-  Matrix r_;                // (p+1) x (p+1)
-  Matrix linv_;             // p x p lower triangular R^-T, or empty
-  Eigen::VectorXd work_;    // row being absorbed, size p+1
-  Eigen::VectorXd work_inv_;  // its counterpart in the inverse, size p
+  // Rows padded with zeros to whole vector lanes (givens.hpp).
+  Matrix r_;                // (p+1) x padded(p+1)
+  Matrix linv_;             // p x padded(p) lower triangular R^-T, or empty
+  Eigen::VectorXd work_;    // row being absorbed, p+1 values and padding
+  Eigen::VectorXd work_inv_;  // its counterpart in the inverse, p and padding
   // Absorbs work_ into r_ (rows >= first), pivot rows scaled by `scale`
   // first (scale != 1 needs first == 0).
   void absorb(std::size_t first, double scale) noexcept;
   void absorb_with_inverse(std::size_t first, double scale) noexcept;
   void absorb_row(std::size_t i, double scale) noexcept;  // rotation i only
   void refresh_prior() noexcept;  // the kept-alive prior row, when due
+  // Tracked block covariances: after a row, S_b = growth S_b - v_b v_b^T;
+  // one block a sample recomputed from L (at regressor b0).
+  void downdate_block_covariances(double growth) noexcept;
+  void resync_block_covariance(std::size_t b0) noexcept;
+  // L^T z, cached until the factor changes.
+  const double* coefficients_from_inverse() const noexcept;
+  // g^T S^-1 g from scratch (S lower triangle, g in row count); -1 if S is
+  // not positive definite.
+  static double wald_quadratic(Matrix& scratch, std::size_t count) noexcept;
+
+  std::size_t wald_block_ = 0;
+  Matrix block_cov_;               // p x wald_block: block b's S in rows of b
+  std::size_t next_resync_ = 0;    // first regressor of the next block to resync
+  std::uint64_t changes_ = 0;      // bumped by every absorbed row
+  mutable std::uint64_t coef_stamp_ = ~std::uint64_t{0};
+  mutable Eigen::VectorXd coef_;   // L^T z when coef_stamp_ == changes_
 };
 
 }  // namespace mpm

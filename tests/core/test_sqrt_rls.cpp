@@ -211,6 +211,38 @@ TEST(SqrtRls, TrackedInverseStaysTheInverseOverLongRuns) {
   }
 }
 
+// Block covariances tracked by rank-one downdates (plus one block
+// recomputed a sample) equal re-triangularisation over long runs, through a
+// stretch without excitation where the kept-alive prior takes over.
+TEST(SqrtRls, TrackedBlockCovariancesStayExact) {
+  const std::size_t nb = 4, m = 5, p = m * nb;
+  for (double lambda : {1.0, 0.99}) {
+    SqrtRls plain(p, lambda, 1e-6);
+    SqrtRls blocks(p, lambda, 1e-6, true, nb);
+    DataGen gen(static_cast<int>(p));
+    Eigen::VectorXd x(static_cast<Eigen::Index>(p));
+    double y = 0;
+    SqrtRls::Matrix scratch(static_cast<Eigen::Index>(p + 1), static_cast<Eigen::Index>(p + 1));
+    const auto check = [&](const char* when) {
+      for (std::size_t b = 0; b + 1 < m; ++b) {  // the last block is trailing: a prefix sum either way
+        const double ref = plain.rss_without(b * nb, nb, scratch);
+        const double fast = blocks.rss_without_wald(b * nb, nb, scratch);
+        EXPECT_NEAR(fast / ref, 1.0, 1e-8) << when << " block " << b << " lambda " << lambda;
+      }
+    };
+    for (int k = 0; k < 100'000; ++k) {
+      gen.next(x, y);
+      if (k >= 40'000 && k < 42'000) x.tail(2 * nb).setConstant(1.5);  // two inputs frozen
+      plain.update(x.data(), y);
+      blocks.update(x.data(), y);
+      if (k == 41'999) check("after the frozen stretch");
+    }
+    check("at the end");
+    EXPECT_THROW(SqrtRls(p, lambda, 1e-6, false, nb), std::invalid_argument);  // needs the inverse
+    EXPECT_THROW(SqrtRls(p + 1, lambda, 1e-6, true, nb), std::invalid_argument);  // whole blocks only
+  }
+}
+
 TEST(SqrtRls, WaldFallsBackWithoutTrackedInverse) {
   const int p = 8;
   SqrtRls rls(p, 0.999, kDelta);
