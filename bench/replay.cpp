@@ -1,5 +1,7 @@
 #include "bench/replay.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -12,6 +14,7 @@
 #include "core/granger_monitor.hpp"
 #include "core/mimo_model.hpp"
 #include "core/noise_filter.hpp"
+#include "daemon/offline.hpp"
 #include "sim/builtin_plants.hpp"
 
 namespace mpm::bench {
@@ -43,14 +46,6 @@ std::vector<double> record(const PlantModel& plant, std::size_t samples) {
   return data;
 }
 
-std::vector<std::optional<std::vector<double>>> noise_ar(const PlantModel& plant, int order) {
-  std::vector<std::optional<std::vector<double>>> out;
-  for (const auto& nm : plant.noise) {
-    if (nm) out.emplace_back(inverse_noise_ar_coefficients(nm->tf, order));
-    else out.emplace_back(std::nullopt);
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -62,21 +57,49 @@ ReplayResult measure_replay(std::size_t samples) {
 
   const MonitorSettings settings = paper_settings();
   ResidualGenerator residuals(plant, std::vector<double>(m, 0.0));
-  GrangerMonitor monitor(m, n, settings, noise_ar(plant, settings.ar_order));
+  const auto noise = noise_ar(plant, settings.ar_order);
+  GrangerMonitor monitor(m, n, settings, noise);
   std::vector<double> d(n);
 
   ReplayResult r;
   r.samples = samples;
-  AllocationScope scope;
-  const double start = thread_cpu_seconds();
+  {
+    AllocationScope scope;
+    const double start = thread_cpu_seconds();
+    for (std::size_t k = 0; k < samples; ++k) {
+      const double* u = data.data() + k * (m + n);
+      residuals.step(u, u + m, d.data());
+      monitor.update(u, d.data());
+    }
+    const double seconds = thread_cpu_seconds() - start;
+    r.allocations = scope.count();
+    r.samples_per_s = static_cast<double>(samples) / seconds;
+  }
+
+  // The same replay as `mpm monitor` runs it: residuals first, then the
+  // outputs split over threads (run_monitor_parallel), wall-clock time.
+  std::vector<double> inputs(samples * m), residual(samples * n);
+  for (std::size_t k = 0; k < samples; ++k)
+    std::copy(data.data() + k * (m + n), data.data() + k * (m + n) + m, inputs.data() + k * m);
+  const auto make = [&](OutputRange outputs) { return GrangerMonitor(m, n, settings, noise, {}, {}, outputs); };
+  GrangerMonitor merged = make(OutputRange{});
+  ResidualGenerator residuals2(plant, std::vector<double>(m, 0.0));
+  r.threads = replay_threads(n);
+  const auto wall_start = std::chrono::steady_clock::now();
   for (std::size_t k = 0; k < samples; ++k) {
     const double* u = data.data() + k * (m + n);
-    residuals.step(u, u + m, d.data());
-    monitor.update(u, d.data());
+    residuals2.step(u, u + m, residual.data() + k * n);
   }
-  const double seconds = thread_cpu_seconds() - start;
-  r.allocations = scope.count();
-  r.samples_per_s = static_cast<double>(samples) / seconds;
+  run_monitor_parallel(merged, inputs.data(), residual.data(), 0, samples, r.threads, make);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  r.parallel_samples_per_s = static_cast<double>(samples) / wall;
+  // The split must not change a single statistic.
+  r.parallel_identical = true;
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t i = 0; i < m; ++i)
+      r.parallel_identical = r.parallel_identical &&
+                             merged.channel(j, i).lr_conditional == monitor.channel(j, i).lr_conditional &&
+                             merged.channel(j, i).gamma == monitor.channel(j, i).gamma;
   return r;
 }
 

@@ -9,7 +9,12 @@
 namespace mpm::bench {
 
 struct ReplayResult {
-  double samples_per_s = 0.0;
+  double samples_per_s = 0.0;           // one thread, thread CPU time
+  double parallel_samples_per_s = 0.0;  // as `mpm monitor` runs it: residuals,
+                                        // then the outputs over `threads`
+                                        // threads; wall-clock time
+  std::size_t threads = 1;
+  bool parallel_identical = false;      // the split changed no statistic
   std::size_t samples = 0;
   std::int64_t allocations = 0;  // during the timed replay (must be 0)
 };

@@ -52,10 +52,14 @@ std::string MonitorSettings::validate() const {
 GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, const MonitorSettings& settings,
                                std::vector<std::optional<std::vector<double>>> n_inverse_ar,
                                std::vector<double> reference_variance,
-                               const std::vector<std::optional<DiscreteTf>>& channel_models)
+                               const std::vector<std::optional<DiscreteTf>>& channel_models,
+                               OutputRange modelled)
     : settings_(settings), n_inputs_(n_inputs), n_outputs_(n_outputs) {
   if (const std::string err = settings.validate(); !err.empty()) throw std::invalid_argument(err);
   if (n_inputs == 0 || n_outputs == 0) throw std::invalid_argument("monitor needs at least one input and one output");
+  if (modelled.first >= n_outputs) throw std::invalid_argument("modelled outputs: the range starts past the last output");
+  first_output_ = modelled.first;
+  end_output_ = modelled.first + std::min(modelled.count, n_outputs - modelled.first);
   if (!n_inverse_ar.empty() && n_inverse_ar.size() != n_outputs)
     throw std::invalid_argument("noise models: need one entry per output");
   na_ = static_cast<std::size_t>(settings.ar_order);
@@ -91,9 +95,11 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
     lags_needed_ = std::max(lags_needed_, static_cast<int>(nb_) + static_cast<int>(std::ceil(std::log(0.01) / std::log(settings.input_pole))));
   warmup_ = settings.warmup > 0 ? settings.warmup : static_cast<int>(10 * p_full);
 
-  regressions_.assign(n_outputs, NestedRls(1 + na_, n_inputs, nb_, settings.forgetting, kRegularization,
-                                           n_inputs >= kWaldMinInputs));
-  for (NestedRls& r : regressions_) regression_ptrs_.push_back(&r);
+  // Factors only for the modelled outputs (the others stay empty).
+  regressions_.resize(n_outputs);
+  for (std::size_t j = first_output_; j < end_output_; ++j) {
+    regressions_[j] = NestedRls(1 + na_, n_inputs, nb_, settings.forgetting, kRegularization, n_inputs >= kWaldMinInputs);
+  }
   residual_lags_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(na_), static_cast<Eigen::Index>(n_outputs));
   input_ref_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_inputs));
   pair_coef_.resize(static_cast<Eigen::Index>(1 + na_));
@@ -128,7 +134,7 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
 }
 
 void GrangerMonitor::reset() noexcept {
-  for (auto& r : regressions_) r.reset();
+  for (std::size_t j = first_output_; j < end_output_; ++j) regressions_[j].reset();
   residual_lags_.setZero();
   input_lags_.setZero();
   for (auto& f : channel_filters_)
@@ -195,7 +201,7 @@ void GrangerMonitor::absorb_sample(const double* residual) noexcept {
   // Regressor rows written straight into each output's staged row:
   // [1, AR lags of d~_j, lags of u_1, ..., u_m, target d~_j(k)].
   const std::size_t inputs = n_inputs_ * nb_;
-  for (std::size_t j = 0; j < n_outputs_; ++j) {
+  for (std::size_t j = first_output_; j < end_output_; ++j) {
     const double* ar = residual_lags_.col(static_cast<Eigen::Index>(j)).data();
     const double* lags = input_lags_.col(static_cast<Eigen::Index>(j * n_inputs_)).data();  // nb per input
     double* f = regressions_[j].staged_row();
@@ -204,7 +210,7 @@ void GrangerMonitor::absorb_sample(const double* residual) noexcept {
     std::copy(lags, lags + inputs, f + 1 + na_);
     f[1 + na_ + inputs] = residual[j];
   }
-  NestedRls::update_staged(regression_ptrs_.data(), regression_ptrs_.size());
+  NestedRls::update_staged(regressions_.data() + first_output_, end_output_ - first_output_);
 }
 
 void GrangerMonitor::push_lags(const double* u, const double* residual) noexcept {
@@ -216,7 +222,7 @@ void GrangerMonitor::push_lags(const double* u, const double* residual) noexcept
   // x_r <- a x_r + x_{r-1}(old) - a x_{r-1}(new). With a = 0: a shift register.
   const double a = settings_.input_pole;
   const double gain = std::sqrt(1.0 - a * a);
-  for (std::size_t c = 0; c < n_outputs_ * n_inputs_; ++c) {
+  for (std::size_t c = first_output_ * n_inputs_; c < end_output_ * n_inputs_; ++c) {
     const std::size_t i = c % n_inputs_;
     double source = u[i] - input_ref_[static_cast<Eigen::Index>(i)];
     if (channel_filters_[c]) source = channel_filters_[c]->step(source);
@@ -233,7 +239,7 @@ void GrangerMonitor::push_lags(const double* u, const double* residual) noexcept
 }
 
 void GrangerMonitor::update_divergence(const double* residual) noexcept {
-  for (std::size_t j = 0; j < n_outputs_; ++j) {
+  for (std::size_t j = first_output_; j < end_output_; ++j) {
     const auto jj = static_cast<Eigen::Index>(j);
     // Residuals carry the outputs' operating-point offset: start the running
     // mean there, not at zero.
@@ -256,7 +262,7 @@ void GrangerMonitor::update_statistics() noexcept {
   const double scale_full = std::max(n_eq_ - static_cast<double>(p_full), 1.0);
   const double scale_pair = std::max(n_eq_ - static_cast<double>(p_pair), 1.0);
   const bool testing = ready();
-  for (std::size_t j = 0; j < n_outputs_; ++j) {
+  for (std::size_t j = first_output_; j < end_output_; ++j) {
     const NestedRls& reg = regressions_[j];
     LoopStats& loop = loops_[j];
     const double rss_full = reg.rss_full();
@@ -321,6 +327,38 @@ void GrangerMonitor::update_hysteresis(Stats& s, double lr, double raise, double
   }
   if (!alarm && s.above >= settings_.raise_after) alarm = true;
   if (alarm && s.below >= settings_.clear_after) alarm = false;
+}
+
+void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
+  if (part.n_inputs_ != n_inputs_ || part.n_outputs_ != n_outputs_ || part.na_ != na_ || part.nb_ != nb_ ||
+      part.lags_needed_ != lags_needed_ || part.warmup_ != warmup_)
+    throw std::invalid_argument("adopt_outputs: the monitors differ in shape or settings");
+  if (part.first_output_ < first_output_ || part.end_output_ > end_output_)
+    throw std::invalid_argument("adopt_outputs: the part models outputs this monitor does not");
+  for (std::size_t j = part.first_output_; j < part.end_output_; ++j) {
+    const auto jj = static_cast<Eigen::Index>(j);
+    regressions_[j] = part.regressions_[j];
+    residual_lags_.col(jj) = part.residual_lags_.col(jj);
+    for (std::size_t i = 0; i < n_inputs_; ++i) {
+      const std::size_t c = j * n_inputs_ + i;
+      input_lags_.col(static_cast<Eigen::Index>(c)) = part.input_lags_.col(static_cast<Eigen::Index>(c));
+      channel_filters_[c] = part.channel_filters_[c];
+      channels_[c] = part.channels_[c];
+    }
+    loops_[j] = part.loops_[j];
+    mean_fast_[jj] = part.mean_fast_[jj];
+    var_fast_[jj] = part.var_fast_[jj];
+    var_baseline_[jj] = part.var_baseline_[jj];
+  }
+  // What every part computed alike from the same samples.
+  counters_ = part.counters_;
+  in_gap_ = part.in_gap_;
+  used_since_reset_ = part.used_since_reset_;
+  lags_filled_ = part.lags_filled_;
+  input_ref_ = part.input_ref_;
+  sum_w_ = part.sum_w_;
+  sum_w2_ = part.sum_w2_;
+  n_eq_ = part.n_eq_;
 }
 
 void GrangerMonitor::full_coefficients(std::size_t output, Eigen::Ref<Eigen::VectorXd> out) const noexcept {

@@ -120,6 +120,17 @@ struct MonitorCounters {
   std::uint64_t gaps = 0;        // runs of missing samples
 };
 
+// The outputs a monitor models: [first, first + count), clipped to the
+// plant's outputs. A monitor of a part of the outputs still takes whole
+// samples (every input and residual, so it skips gaps and settles exactly as
+// the whole monitor does) and its statistics for those outputs equal the
+// whole monitor's bit for bit: parts can run on separate threads over a
+// recording and be merged (adopt_outputs).
+struct OutputRange {
+  std::size_t first = 0;
+  std::size_t count = static_cast<std::size_t>(-1);
+};
+
 class GrangerMonitor {
  public:
   // Allocates everything. `n_inverse_ar[j]`, when given, holds the coefficients
@@ -134,7 +145,8 @@ class GrangerMonitor {
   GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, const MonitorSettings& settings,
                  std::vector<std::optional<std::vector<double>>> n_inverse_ar = {},
                  std::vector<double> reference_variance = {},
-                 const std::vector<std::optional<DiscreteTf>>& channel_models = {});
+                 const std::vector<std::optional<DiscreteTf>>& channel_models = {},
+                 OutputRange modelled = {});
 
   // Real-time safe: no allocation, no exceptions. u: n_inputs values at time
   // k, residual: n_outputs values of d~ at time k. Returns what was done.
@@ -175,6 +187,15 @@ class GrangerMonitor {
   // Forgets everything learnt: statistics, lags, alarms (counters are kept).
   void reset() noexcept;
 
+  // The outputs this monitor models (all unless constructed with a range);
+  // statistics of the others stay at their initial values.
+  std::size_t first_modelled_output() const noexcept { return first_output_; }
+  std::size_t end_modelled_output() const noexcept { return end_output_; }
+  // Takes over the state of the outputs `part` models from `part`, a monitor
+  // of the same plant and settings fed the same samples. Not real-time
+  // (copies factors); throws std::invalid_argument when they do not match.
+  void adopt_outputs(const GrangerMonitor& part);
+
  private:
   void absorb_sample(const double* residual) noexcept;
   void push_lags(const double* u, const double* residual) noexcept;
@@ -186,6 +207,8 @@ class GrangerMonitor {
   MonitorSettings settings_;
   std::size_t n_inputs_;
   std::size_t n_outputs_;
+  std::size_t first_output_ = 0;   // modelled outputs [first_output_, end_output_)
+  std::size_t end_output_ = 0;
   std::size_t na_;
   std::size_t nb_;
   int warmup_;
@@ -207,7 +230,6 @@ class GrangerMonitor {
   // One per output: the full model [1, AR, u_1 .. u_m] and the pairwise
   // models [1, AR, u_i] in one shared update (nested_rls.hpp).
   std::vector<NestedRls> regressions_;
-  std::vector<NestedRls*> regression_ptrs_;  // the same, for update_staged
   mutable Eigen::VectorXd pair_coef_;  // scratch: [1, AR] coefficients of a pairwise model
   SqrtRls::Matrix scratch_;        // scratch for conditional RSS
 

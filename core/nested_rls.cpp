@@ -90,19 +90,18 @@ void NestedRls::add_to_lowers() noexcept {
 void NestedRls::update(const double* x, double y) noexcept {
   std::copy(x, x + (cols_ - 1), row_.data());
   row_[static_cast<Eigen::Index>(cols_ - 1)] = y;
-  NestedRls* self = this;
-  update_staged(&self, 1);
+  update_staged(this, 1);
 }
 
-void NestedRls::update_staged(NestedRls* const* models, std::size_t count) noexcept {
+void NestedRls::update_staged(NestedRls* models, std::size_t count) noexcept {
   // The trapezoids' rotation i of every model, then rotation i + 1, so the
   // models' chains of dependent square roots and divisions overlap.
   std::size_t rows = 0;
-  for (std::size_t k = 0; k < count; ++k) rows = std::max(rows, models[k]->a_);
-  for (std::size_t k = 0; k < count; ++k) models[k]->row_inv_.setZero();
+  for (std::size_t k = 0; k < count; ++k) rows = std::max(rows, models[k].a_);
+  for (std::size_t k = 0; k < count; ++k) models[k].row_inv_.setZero();
   for (std::size_t i = 0; i < rows; ++i)
     for (std::size_t k = 0; k < count; ++k)
-      if (i < models[k]->a_) models[k]->rotate_top_row(i, models[k]->sqrt_lambda_);
+      if (i < models[k].a_) models[k].rotate_top_row(i, models[k].sqrt_lambda_);
   // Then every lower factor, a few at a time.
   SqrtRls* group[kLockstep];
   std::size_t in_group = 0;
@@ -114,13 +113,13 @@ void NestedRls::update_staged(NestedRls* const* models, std::size_t count) noexc
     }
   };
   for (std::size_t k = 0; k < count; ++k) {
-    NestedRls& n = *models[k];
+    NestedRls& n = models[k];
     n.stage_lowers();
     add(n.lower_);
     for (SqrtRls& p : n.pairs_) add(p);
   }
   if (in_group > 0) SqrtRls::update_staged(group, in_group);
-  for (std::size_t k = 0; k < count; ++k) models[k]->refresh_prior();
+  for (std::size_t k = 0; k < count; ++k) models[k].refresh_prior();
 }
 
 void NestedRls::refresh_prior() noexcept {

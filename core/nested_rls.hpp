@@ -55,7 +55,8 @@ class NestedRls {
   // staged_row() (n_regressors() + 1 values) of each model, then
   // update_staged() interleaves the rotations of all of them.
   double* staged_row() noexcept { return row_.data(); }
-  static void update_staged(NestedRls* const* models, std::size_t count) noexcept;
+  // `models`: an array of `count` of them.
+  static void update_staged(NestedRls* models, std::size_t count) noexcept;
 
   // Weighted residual sums of squares:
   // of the model of the first k <= prefix() regressors of A,

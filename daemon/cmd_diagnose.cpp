@@ -209,9 +209,14 @@ int run(int argc, char** argv) {
 
     MonitorSettings settings;
     settings.forgetting = 1.0;
-    GrangerMonitor monitor(plant.n_inputs(), plant.n_outputs(), settings, noise_ar(plant, settings.ar_order),
-                           reference_variances(plant), channel_models(plant));
-    run_monitor(monitor, series, [](std::size_t, const GrangerMonitor&) {});
+    const auto noise = noise_ar(plant, settings.ar_order);
+    const auto reference = reference_variances(plant);
+    const auto channels = channel_models(plant);
+    const auto make = [&](OutputRange outputs) {
+      return GrangerMonitor(plant.n_inputs(), plant.n_outputs(), settings, noise, reference, channels, outputs);
+    };
+    GrangerMonitor monitor = make(OutputRange{});
+    run_monitor_parallel(monitor, series, replay_threads(plant.n_outputs()), make);
     const RecordVerdict verdict = record_verdict(monitor);
 
     progress("fitting structured hypotheses");

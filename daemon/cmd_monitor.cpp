@@ -30,6 +30,8 @@ constexpr const char* kUsage =
     "  --false-alarm A    per-channel test level alpha (default 1e-3)\n"
     "  --plain-lags       regress on plain input lags as in the paper (default: lags of the\n"
     "                     input filtered through the nominal channel G_ji, where it is nonzero)\n"
+    "  --threads N        threads, each replaying a part of the outputs (default: one per\n"
+    "                     core, at most one per output; the result does not depend on it)\n"
     "  --json             print one JSON object instead of the table\n";
 
 struct ChannelTrace {
@@ -88,7 +90,7 @@ void print_json(const PlantModel& plant, const GrangerMonitor& m, const std::vec
 
 int run(int argc, char** argv) {
   try {
-    const Args args(argc, argv, {"plant", "data", "ar-order", "input-order", "input-pole", "forgetting", "false-alarm"},
+    const Args args(argc, argv, {"plant", "data", "ar-order", "input-order", "input-pole", "forgetting", "false-alarm", "threads"},
                     {"json", "plain-lags", "help"});
     if (args.flag("help")) {
       std::fputs(kUsage, stdout);
@@ -103,16 +105,27 @@ int run(int argc, char** argv) {
     const std::string pole = args.get("input-pole").value_or("0");
     settings.input_pole = pole == "auto" ? dominant_pole(plant) : args.number("input-pole", 0.0);
     if (const std::string e = settings.validate(); !e.empty()) throw UsageError(e);
+    const int requested_threads = args.integer("threads", 0);  // 0: one per core
+    if (args.get("threads") && requested_threads < 1) throw UsageError("--threads must be >= 1");
 
     const config::Recording rec = config::load_recording(args.required("data"));
     const config::BoundRecording bound = config::bind(plant, rec);
     const ResidualSeries series = compute_residuals(plant, rec, bound);
 
-    GrangerMonitor monitor(plant.n_inputs(), plant.n_outputs(), settings, noise_ar(plant, settings.ar_order), reference_variances(plant),
-                           args.flag("plain-lags") ? std::vector<std::optional<DiscreteTf>>{} : channel_models(plant));
+    const auto noise = noise_ar(plant, settings.ar_order);
+    const auto reference = reference_variances(plant);
+    const auto channels =
+        args.flag("plain-lags") ? std::vector<std::optional<DiscreteTf>>{} : channel_models(plant);
+    const auto make = [&](OutputRange outputs) {
+      return GrangerMonitor(plant.n_inputs(), plant.n_outputs(), settings, noise, reference, channels, outputs);
+    };
+    const std::size_t threads =
+        requested_threads > 0 ? static_cast<std::size_t>(requested_threads) : replay_threads(plant.n_outputs());
+    GrangerMonitor monitor = make(OutputRange{});
     std::vector<ChannelTrace> trace(plant.n_inputs() * plant.n_outputs());
-    run_monitor(monitor, series, [&](std::size_t k, const GrangerMonitor& m) {
-      for (std::size_t j = 0; j < m.n_outputs(); ++j)
+    // On each part's thread: only its outputs, so the parts write disjoint traces.
+    run_monitor_parallel(monitor, series, threads, make, [&](std::size_t k, const GrangerMonitor& m) {
+      for (std::size_t j = m.first_modelled_output(); j < m.end_modelled_output(); ++j)
         for (std::size_t i = 0; i < m.n_inputs(); ++i) {
           ChannelTrace& t = trace[j * m.n_inputs() + i];
           const bool now = m.channel(j, i).alarm;

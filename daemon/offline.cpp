@@ -1,6 +1,9 @@
 #include "daemon/offline.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <thread>
 
 #include "core/mimo_model.hpp"
 #include "core/noise_filter.hpp"
@@ -99,6 +102,53 @@ std::vector<double> reference_variances(const PlantModel& plant) {
   for (std::size_t j = 0; j < plant.n_outputs() && j < plant.noise.size(); ++j)
     if (plant.noise[j] && plant.noise[j]->variance) out[j] = noise_output_variance(plant.noise[j]->tf, *plant.noise[j]->variance);
   return out;
+}
+
+std::size_t replay_threads(std::size_t outputs) {
+  const std::size_t cores = std::max<std::size_t>(1, std::thread::hardware_concurrency());
+  return std::max<std::size_t>(1, std::min(cores, outputs));
+}
+
+void run_monitor_parallel(GrangerMonitor& monitor, const double* u, const double* residual, std::size_t first,
+                          std::size_t samples, std::size_t threads, const MonitorPartFactory& make_part,
+                          const PartSampleCallback& on_sample) {
+  const std::size_t m = monitor.n_inputs();
+  const std::size_t p = monitor.n_outputs();
+  threads = std::max<std::size_t>(1, std::min(threads, p));
+  // Contiguous parts of nearly equal size; built here, so a factory that
+  // throws does so before any thread starts.
+  std::vector<GrangerMonitor> parts;
+  parts.reserve(threads);
+  for (std::size_t t = 0, begin = 0; t < threads; ++t) {
+    const std::size_t count = p / threads + (t < p % threads ? 1 : 0);
+    parts.push_back(make_part(OutputRange{begin, count}));
+    begin += count;
+  }
+  const auto run_part = [&](GrangerMonitor& part) {
+    for (std::size_t k = first; k < samples; ++k) {
+      part.update(u + k * m, residual + k * p);
+      if (on_sample) on_sample(k, part);
+    }
+  };
+  if (threads == 1) {
+    run_part(parts[0]);
+  } else {
+    std::vector<std::thread> workers;
+    workers.reserve(threads - 1);
+    for (std::size_t t = 1; t < threads; ++t) workers.emplace_back(run_part, std::ref(parts[t]));
+    run_part(parts[0]);
+    for (std::thread& w : workers) w.join();
+  }
+  for (const GrangerMonitor& part : parts) monitor.adopt_outputs(part);
+}
+
+void run_monitor_parallel(GrangerMonitor& monitor, const ResidualSeries& s, std::size_t threads,
+                          const MonitorPartFactory& make_part, const PartSampleCallback& on_sample) {
+  // One sample contiguous, for every thread to read.
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> u = s.u;
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> d = s.residual;
+  run_monitor_parallel(monitor, u.data(), d.data(), s.transient, static_cast<std::size_t>(s.u.rows()), threads,
+                       make_part, on_sample);
 }
 
 }  // namespace mpm

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -57,12 +58,37 @@ RecordVerdict record_verdict(const GrangerMonitor& monitor);
 // `on_sample(k, monitor)` after each update when given.
 template <typename OnSample>
 void run_monitor(GrangerMonitor& monitor, const ResidualSeries& s, OnSample&& on_sample) {
+  Eigen::VectorXd u(s.u.cols()), d(s.residual.cols());
   for (Eigen::Index k = static_cast<Eigen::Index>(s.transient); k < s.u.rows(); ++k) {
-    const Eigen::VectorXd u = s.u.row(k).transpose();
-    const Eigen::VectorXd d = s.residual.row(k).transpose();
+    u = s.u.row(k).transpose();
+    d = s.residual.row(k).transpose();
     monitor.update(u.data(), d.data());
     on_sample(static_cast<std::size_t>(k), monitor);
   }
 }
+
+// Builds a monitor of the plant and settings at hand for some of its outputs.
+using MonitorPartFactory = std::function<GrangerMonitor(OutputRange)>;
+// Called after each update of a part, on that part's thread, with the sample
+// index; only the part's outputs (first_modelled_output() ..
+// end_modelled_output()) are meaningful in it.
+using PartSampleCallback = std::function<void(std::size_t, const GrangerMonitor&)>;
+
+// Threads worth using for a monitor of `outputs` outputs on this machine:
+// one per core, at most one per output, at least one.
+std::size_t replay_threads(std::size_t outputs);
+
+// The same as run_monitor over `threads` threads: the outputs' statistics are
+// independent, so each thread runs a monitor of a contiguous part of the
+// outputs over the whole record, and `monitor` then adopts every part (bit
+// for bit what one thread computes; see OutputRange). Samples [first,
+// samples) of `u` (samples x inputs) and `residual` (samples x outputs), one
+// sample contiguous.
+void run_monitor_parallel(GrangerMonitor& monitor, const double* u, const double* residual, std::size_t first,
+                          std::size_t samples, std::size_t threads, const MonitorPartFactory& make_part,
+                          const PartSampleCallback& on_sample = {});
+// The same over a residual series (after its transient).
+void run_monitor_parallel(GrangerMonitor& monitor, const ResidualSeries& s, std::size_t threads,
+                          const MonitorPartFactory& make_part, const PartSampleCallback& on_sample = {});
 
 }  // namespace mpm

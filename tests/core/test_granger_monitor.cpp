@@ -263,6 +263,59 @@ TEST(GrangerMonitor, StatisticsEqualReferenceFits) {
   expect_matches_reference_fits(6);
 }
 
+// Monitors of one output each, fed the same whole samples (with a gap, and
+// with model-filtered regressors of different settling times per output),
+// reproduce the whole monitor bit for bit, and merged back they are it.
+TEST(GrangerMonitor, PartsOfTheOutputsEqualTheWholeMonitor) {
+  const MonitorSettings s = test_settings();
+  // Channel models: output 2's settle far longer than output 1's, so a part
+  // that took only its own into account would restart differently.
+  const std::vector<std::optional<DiscreteTf>> channels = {
+      DiscreteTf{{0.5}, {1, -0.5}, 1}, DiscreteTf{{0.3}, {1, -0.6}, 2},
+      DiscreteTf{{0.2}, {1, -0.97}, 1}, std::nullopt};
+  GrangerMonitor whole(2, 2, s, wood_berry_noise(s.ar_order), {}, channels);
+  GrangerMonitor first(2, 2, s, wood_berry_noise(s.ar_order), {}, channels, OutputRange{0, 1});
+  GrangerMonitor second(2, 2, s, wood_berry_noise(s.ar_order), {}, channels, OutputRange{1, 5});
+  EXPECT_EQ(second.end_modelled_output(), 2u);  // clipped to the plant
+  PlantedRun run(5);
+  run.dg[1][0].emplace(DiscreteTf{{0.4}, {1, -0.6}, 2});
+  for (int k = 0; k < 6000; ++k) {
+    run.step();
+    double d[2] = {run.d[0], run.d[1]};
+    if (k == 3000) d[0] = NAN;  // a gap in one residual skips the sample for all
+    whole.update(run.u, d);
+    first.update(run.u, d);
+    second.update(run.u, d);
+  }
+  EXPECT_EQ(whole.counters().missing, 1u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(first.channel(0, i).lr_conditional, whole.channel(0, i).lr_conditional);
+    EXPECT_EQ(first.channel(0, i).gamma, whole.channel(0, i).gamma);
+    EXPECT_EQ(second.channel(1, i).lr_conditional, whole.channel(1, i).lr_conditional);
+    EXPECT_EQ(second.channel(1, i).f_pairwise, whole.channel(1, i).f_pairwise);
+    EXPECT_EQ(second.channel(1, i).alarm, whole.channel(1, i).alarm);
+  }
+  EXPECT_EQ(second.loop(1).lr_joint, whole.loop(1).lr_joint);
+  EXPECT_TRUE(whole.channel(1, 0).alarm);  // the planted channel: a real check
+  EXPECT_EQ(first.channel(1, 0).lr_conditional, 0.0);  // not modelled there
+
+  GrangerMonitor merged(2, 2, s, wood_berry_noise(s.ar_order), {}, channels);
+  merged.adopt_outputs(first);
+  merged.adopt_outputs(second);
+  EXPECT_EQ(merged.channel(1, 0).lr_conditional, whole.channel(1, 0).lr_conditional);
+  EXPECT_EQ(merged.counters().used, whole.counters().used);
+  // And it goes on exactly as the whole one.
+  for (int k = 0; k < 200; ++k) {
+    run.step();
+    whole.update(run.u, run.d);
+    merged.update(run.u, run.d);
+  }
+  EXPECT_EQ(merged.channel(1, 0).lr_conditional, whole.channel(1, 0).lr_conditional);
+  EXPECT_EQ(merged.channel(0, 1).gamma, whole.channel(0, 1).gamma);
+  GrangerMonitor other(2, 2, test_settings(), {}, {}, {});  // no channel models: settles differently
+  EXPECT_THROW(other.adopt_outputs(first), std::invalid_argument);
+}
+
 TEST(MonitorSettings, ValidateNamesTheField) {
   MonitorSettings s;
   s.forgetting = 1.5;
