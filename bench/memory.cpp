@@ -1,77 +1,565 @@
 #include "bench/memory.hpp"
 
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
-#include <string>
+#include <random>
+#include <sstream>
+#include <thread>
+#include <vector>
 
-#include "bench/workload.hpp"
+#include "sim/builtin_plants.hpp"
+
+#ifdef MPM_BENCH_HAVE_TRANSPORT
+#include "config/plant_loader.hpp"
+#include "core/mimo_model.hpp"
+#include "transport/transport.hpp"
+#endif
+
+extern char** environ;
 
 namespace mpm::bench {
 
-double status_field_mb(const char* field) {
-  std::ifstream in("/proc/self/status");
-  std::string line;
-  const std::size_t len = std::strlen(field);
-  while (std::getline(in, line)) {
-    if (line.compare(0, len, field) == 0 && line.size() > len && line[len] == ':')
-      return std::stod(line.substr(len + 1)) / 1024.0;  // the file says kB
-  }
-  return 0.0;
-}
+namespace fs = std::filesystem;
 
 namespace {
 
-// In the child: build, run, measure, write three doubles, exit.
-[[noreturn]] void child_measure(int fd, std::size_t inputs, std::size_t outputs) {
-  ResidentMemory m;
-  m.baseline_mb = status_field_mb("VmRSS");
-  {
-    const Workload w = make_workload(inputs, outputs, 64);
-    auto monitor = make_monitor(inputs, outputs);
-    std::size_t k = warm_up(*monitor, w, 0);
-    for (int i = 0; i < 2; ++i, ++k) monitor->update(w.u_at(k), w.residual_at(k));
-    m.rss_mb = status_field_mb("VmRSS");
-    m.hwm_mb = status_field_mb("VmHWM");
-  }
-  const ssize_t written = write(fd, &m, sizeof m);
-  _exit(written == static_cast<ssize_t>(sizeof m) ? 0 : 1);
+bool is_executable_file(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(path.c_str(), X_OK) == 0;
 }
 
 }  // namespace
 
-std::optional<ResidentMemory> measure_monitor_memory(std::size_t inputs, std::size_t outputs, std::string& why) {
-  int fds[2];
-  if (pipe(fds) != 0) {
-    why = std::string("pipe failed: ") + std::strerror(errno);
-    return std::nullopt;
-  }
-  std::fflush(nullptr);  // the child must not flush our buffered output again
-  const pid_t pid = fork();
-  if (pid < 0) {
-    why = std::string("fork failed: ") + std::strerror(errno);
-    close(fds[0]);
-    close(fds[1]);
-    return std::nullopt;
-  }
-  if (pid == 0) {
-    close(fds[0]);
-    child_measure(fds[1], inputs, outputs);
-  }
-  close(fds[1]);
-  ResidentMemory m;
-  const ssize_t got = read(fds[0], &m, sizeof m);
-  close(fds[0]);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  if (got != static_cast<ssize_t>(sizeof m) || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    why = "the measuring child process failed";
-    return std::nullopt;
-  }
-  return m;
+std::string own_exe_dir() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string() : exe.parent_path().string();
 }
+
+std::optional<std::string> find_mpmd(const std::string& exe_dir, std::string& why) {
+  if (const char* forced = std::getenv("MPM_MPMD"); forced != nullptr && *forced != '\0') {
+    if (is_executable_file(forced)) return std::string(forced);
+    why = std::string("MPM_MPMD=") + forced + " is not an executable file";
+    return std::nullopt;
+  }
+  if (exe_dir.empty()) {
+    why = "no mpmd: the folder of this program is unknown (/proc/self/exe unreadable); set MPM_MPMD";
+    return std::nullopt;
+  }
+  for (const std::string& candidate : {exe_dir + "/mpmd", exe_dir + "/mpmd/mpmd"}) {
+    if (is_executable_file(candidate)) return candidate;
+  }
+  why = "no mpmd executable at " + exe_dir + "/mpmd or " + exe_dir +
+        "/mpmd/mpmd (built with MPM_BUILD_TRANSPORTS=OFF?); set MPM_MPMD to measure one elsewhere";
+  return std::nullopt;
+}
+
+std::string bench_plant_yaml(std::size_t n) {
+  if (n == 2) return std::string(*sim::builtin_plant_text("wood-berry.yaml"));
+  std::ostringstream y;
+  y.precision(6);
+  y << "# " << n << "x" << n << " benchmark plant written by `mpm bench`: first-order channels with dead time.\n"
+    << "plant: bench-" << n << "x" << n << "\nsample_time: 1\ninputs: [";
+  for (std::size_t i = 0; i < n; ++i) y << (i ? ", u" : "u") << i + 1;
+  y << "]\noutputs: [";
+  for (std::size_t j = 0; j < n; ++j) y << (j ? ", y" : "y") << j + 1;
+  y << "]\nmodel:\n";
+  for (std::size_t j = 0; j < n; ++j) {
+    for (std::size_t i = 0; i < n; ++i) {
+      // Deterministic spread of poles 0.80..0.95, gains +-(0.2..1.0), delays 1..5.
+      const std::size_t k = j * n + i;
+      const double pole = 0.80 + 0.15 * static_cast<double>((k * 37) % 101) / 100.0;
+      const double gain = (k % 3 == 0 ? -1.0 : 1.0) * (0.2 + 0.8 * static_cast<double>((k * 53) % 97) / 96.0);
+      y << "  - {output: y" << j + 1 << ", input: u" << i + 1 << ", num: [" << gain * (1.0 - pole) << "], den: [1, "
+        << -pole << "], delay: " << 1 + (i + 2 * j) % 5 << "}\n";
+    }
+  }
+  y << "noise:\n";
+  for (std::size_t j = 0; j < n; ++j)
+    y << "  - {output: y" << j + 1 << ", num: [1], den: [1, -" << (j % 2 ? 0.9 : 0.8) << "], variance: 1}\n";
+  std::string zeros;
+  for (std::size_t i = 0; i < n; ++i) zeros += i ? ", 0" : "0";
+  y << "operating_point:\n  inputs: [" << zeros << "]\n  outputs: [" << zeros << "]\n";
+  return y.str();
+}
+
+#ifndef MPM_BENCH_HAVE_TRANSPORT
+
+std::optional<MpmdMemory> measure_mpmd_memory(const MpmdRun&, std::string& why) {
+  why = "this mpm was built without the transports (MPM_BUILD_TRANSPORTS=OFF): it cannot feed mpmd samples";
+  return std::nullopt;
+}
+
+#else
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Samples per chunk: each chunk is confirmed by a status before the next is
+// sent, so a burst never overruns a socket buffer (UDP would drop silently).
+constexpr std::size_t kChunk = 50;
+// Longest wait for a chunk's confirmation (at 50x50 a used sample takes ~50 ms).
+constexpr std::chrono::seconds kChunkTimeout{60};
+
+// A fresh folder from mkdtemp, removed with everything in it on destruction.
+class TempDir {
+ public:
+  bool make(std::string& why) {
+    std::error_code ec;
+    const fs::path base = fs::temp_directory_path(ec);
+    std::string pattern = ((ec ? fs::path("/tmp") : base) / "mpm-bench-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr) {
+      why = "mkdtemp(" + pattern + ") failed: " + std::strerror(errno);
+      return false;
+    }
+    path_ = pattern;
+    return true;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    if (!path_.empty()) fs::remove_all(path_, ec);
+  }
+  std::string file(const char* name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+bool write_text(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  return static_cast<bool>(out);
+}
+
+// The last non-empty line of a file (mpmd's stderr), "" if none.
+std::string last_line(const std::string& path) {
+  std::ifstream in(path);
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+  }
+  return last;
+}
+
+// Fields of /proc/<pid>/status in MB (the file gives kB); 0 when absent.
+struct ProcStatus {
+  double vm_rss = 0.0, vm_hwm = 0.0, rss_anon = 0.0, rss_file = 0.0;
+};
+bool read_proc_status(pid_t pid, ProcStatus& s) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
+  if (!in) return false;
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto colon = line.find(':');
+    if (colon == std::string::npos) continue;
+    const std::string key = line.substr(0, colon);
+    double* field = key == "VmRSS"     ? &s.vm_rss
+                    : key == "VmHWM"   ? &s.vm_hwm
+                    : key == "RssAnon" ? &s.rss_anon
+                    : key == "RssFile" ? &s.rss_file
+                                       : nullptr;
+    if (field) *field = std::strtod(line.c_str() + colon + 1, nullptr) / 1024.0;
+  }
+  return s.vm_rss > 0.0;
+}
+
+std::string describe_exit(int status) {
+  if (WIFEXITED(status)) return "exited with code " + std::to_string(WEXITSTATUS(status));
+  if (WIFSIGNALED(status)) return std::string("was killed by signal ") + strsignal(WTERMSIG(status));
+  return "stopped";
+}
+
+// The mpmd child: started with fork/exec, its stdout and stderr to one file;
+// stopped (SIGTERM, then SIGKILL) and reaped by stop() or the destructor.
+class Child {
+ public:
+  explicit Child(std::chrono::milliseconds stop_timeout) : stop_timeout_(stop_timeout) {}
+  ~Child() { stop(); }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+
+  bool start(const std::vector<std::string>& args, const std::vector<std::string>& env, const std::string& log,
+             std::string& why) {
+    // Everything the child needs is made before fork: after it, only
+    // async-signal-safe calls.
+    std::vector<char*> argv, envp;
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    for (const auto& e : env) envp.push_back(const_cast<char*>(e.c_str()));
+    envp.push_back(nullptr);
+    const int out = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    const int in = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+    if (out < 0 || in < 0) {
+      why = "cannot open " + log + " or /dev/null: " + std::strerror(errno);
+      if (out >= 0) ::close(out);
+      if (in >= 0) ::close(in);
+      return false;
+    }
+    const pid_t parent = ::getpid();
+    std::fflush(nullptr);
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      // Dies with us even if we are killed before stopping it.
+      ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+      if (::getppid() != parent) ::_exit(126);
+      ::dup2(in, 0);
+      ::dup2(out, 1);
+      ::dup2(out, 2);
+      ::close_range(3, ~0U, 0);  // no LCM socket or notify socket of ours in mpmd
+      ::execve(argv[0], argv.data(), envp.data());
+      constexpr char kFailed[] = "<3>mpm bench: execve of mpmd failed\n";
+      [[maybe_unused]] const ssize_t n = ::write(2, kFailed, sizeof kFailed - 1);
+      ::_exit(127);
+    }
+    const int fork_errno = errno;
+    ::close(out);
+    ::close(in);
+    if (pid_ < 0) {
+      why = std::string("fork failed: ") + std::strerror(fork_errno);
+      return false;
+    }
+    return true;
+  }
+
+  pid_t pid() const { return pid_; }
+
+  // False once it has exited (then exit_status() says how).
+  bool running() {
+    if (pid_ <= 0 || status_) return false;
+    int status = 0;
+    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+      status_ = status;
+      return false;
+    }
+    return true;
+  }
+  std::optional<int> exit_status() const { return status_; }
+
+  // SIGTERM, up to stop_timeout for it to exit, then SIGKILL; always reaped.
+  void stop() {
+    if (!running()) return;
+    ::kill(pid_, SIGTERM);
+    const auto deadline = Clock::now() + stop_timeout_;
+    while (running() && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (!running()) return;
+    ::kill(pid_, SIGKILL);
+    int status = 0;
+    while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+    }
+    status_ = status;
+  }
+
+ private:
+  std::chrono::milliseconds stop_timeout_;
+  pid_t pid_ = -1;
+  std::optional<int> status_;
+};
+
+// The systemd side of sd_notify: a datagram socket bound to a path that the
+// child finds in NOTIFY_SOCKET.
+class NotifySocket {
+ public:
+  ~NotifySocket() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  bool bind(const std::string& path, std::string& why) {
+    sockaddr_un addr{};
+    if (path.size() >= sizeof addr.sun_path) {
+      why = "notify socket path too long: " + path;
+      return false;
+    }
+    fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    addr.sun_family = AF_UNIX;
+    std::memcpy(addr.sun_path, path.c_str(), path.size() + 1);
+    if (fd_ < 0 || ::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+      why = "cannot bind the notify socket " + path + ": " + std::strerror(errno);
+      return false;
+    }
+    return true;
+  }
+  // Waits up to `wait` for a datagram; true when one containing `needle` came.
+  bool receive(const char* needle, std::chrono::milliseconds wait) {
+    pollfd p{fd_, POLLIN, 0};
+    if (::poll(&p, 1, static_cast<int>(wait.count())) <= 0) return false;
+    char buf[1024];
+    const ssize_t n = ::recv(fd_, buf, sizeof buf - 1, MSG_DONTWAIT);
+    if (n <= 0) return false;
+    buf[n] = '\0';
+    return std::strstr(buf, needle) != nullptr;
+  }
+
+ private:
+  int fd_ = -1;
+};
+
+// Samples as a controller would publish them for a matched plant:
+// y = y0 + G_M (u - u0) + d, u white around u0, d of the plant's first-order
+// noise models (white where there is none). A matched plant raises no alarm
+// storm that would make mpmd's memory a measure of its logging.
+class SampleSource {
+ public:
+  SampleSource(const PlantModel& plant, const std::string& controller)
+      : u0_(plant.n_inputs(), 0.0),
+        y0_(plant.n_outputs(), 0.0),
+        pole_(plant.n_outputs(), 0.0),
+        d_(plant.n_outputs(), 0.0),
+        zeros_(plant.n_outputs(), 0.0),
+        minus_model_(plant.n_outputs(), 0.0),
+        rng_(7) {
+    if (plant.operating_point) {
+      u0_ = plant.operating_point->inputs;
+      y0_ = plant.operating_point->outputs;
+    }
+    for (std::size_t j = 0; j < plant.n_outputs(); ++j) {
+      const auto& n = plant.noise[j];
+      if (n && n->tf.den.size() == 2 && n->tf.num.size() == 1) pole_[j] = -n->tf.den[1] / n->tf.den[0];
+    }
+    model_ = ResidualGenerator(plant, u0_);
+    sample_.controller_id = controller;
+    sample_.session_id = 1;
+    sample_.u.resize(plant.n_inputs());
+    sample_.y.resize(plant.n_outputs());
+  }
+  const msg::Sample& next() {
+    for (std::size_t i = 0; i < u0_.size(); ++i) sample_.u[i] = u0_[i] + normal_(rng_);
+    model_.step(sample_.u.data(), zeros_.data(), minus_model_.data());  // 0 - G_M (u - u0)
+    for (std::size_t j = 0; j < y0_.size(); ++j) {
+      d_[j] = pole_[j] * d_[j] + normal_(rng_);  // variance 1, as the plant files say
+      sample_.y[j] = y0_[j] - minus_model_[j] + d_[j];
+    }
+    ++sample_.seq;
+    sample_.utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                        std::chrono::system_clock::now().time_since_epoch())
+                        .count();
+    return sample_;
+  }
+
+ private:
+  std::vector<double> u0_, y0_, pole_, d_, zeros_, minus_model_;
+  ResidualGenerator model_;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+  msg::Sample sample_;
+};
+
+std::string tag(std::size_t n) { return std::to_string(n) + "x" + std::to_string(n); }
+
+// A YAML single-quoted scalar: any path, spaces and colons included.
+std::string quoted(const std::string& text) {
+  std::string q = "'";
+  for (const char c : text) q += c == '\'' ? std::string("''") : std::string(1, c);
+  return q + "'";
+}
+
+std::string daemon_yaml(const std::string& plant_path, const std::string& controller,
+                        const transport::LcmSettings& lcm) {
+  return "# written by `mpm bench` to measure mpmd's resident memory\n"
+         "controller_id: " + controller + "\n"
+         "plant: " + quoted(plant_path) + "\n"
+         "monitor:            # the orders of the paper, as the other bench figures\n"
+         "  ar_order: 20\n"
+         "  input_order: 10\n"
+         "  forgetting: 0.999\n"
+         "  settle_samples: 0 # every sample reaches the monitor\n"
+         "transport:\n"
+         "  kind: lcm\n"
+         "  lcm:\n"
+         "    url: \"" + lcm.url + "\"\n"
+         "    sample_channel: " + lcm.sample_channel + "\n"
+         "    alarm_channel: " + lcm.alarm_channel + "\n"
+         "    status_channel: " + lcm.status_channel + "\n"
+         "status_period: 0.1  # the status confirms each chunk of samples\n"
+         "log_interval: 3600\n";
+}
+
+// Our environment, with NOTIFY_SOCKET ours and no systemd watchdog.
+std::vector<std::string> child_environment(const std::string& notify_path) {
+  std::vector<std::string> env;
+  for (char** e = environ; e != nullptr && *e != nullptr; ++e) {
+    const std::string entry = *e;
+    if (entry.rfind("NOTIFY_SOCKET=", 0) == 0 || entry.rfind("WATCHDOG_", 0) == 0) continue;
+    env.push_back(entry);
+  }
+  env.push_back("NOTIFY_SOCKET=" + notify_path);
+  return env;
+}
+
+// What the last status of our controller said.
+struct Seen {
+  std::int64_t seen = -1;
+  std::int64_t used = 0;
+};
+
+class Measurement {
+ public:
+  Measurement(const MpmdRun& run, std::string& why) : run_(run), why_(why), child_(run.stop_timeout) {}
+
+  std::optional<MpmdMemory> run() {
+    if (!dir_.make(why_) || !write_files() || !open_transport() || !notify_.bind(dir_.file("notify.sock"), why_))
+      return std::nullopt;
+    if (!child_.start({run_.mpmd, "--config", dir_.file("mpmd.yaml")}, child_environment(dir_.file("notify.sock")),
+                      dir_.file("mpmd.log"), why_))
+      return std::nullopt;
+    MpmdMemory m;
+    m.pid = child_.pid();
+    m.url = lcm_.url;
+    if (!wait_ready()) return std::nullopt;
+    ProcStatus at_ready;
+    if (!read_proc_status(m.pid, at_ready)) {
+      fail("cannot read /proc/" + std::to_string(m.pid) + "/status");
+      return std::nullopt;
+    }
+    m.ready_rss_mb = at_ready.vm_rss;
+    m.ready_anon_mb = at_ready.rss_anon;
+    if (!feed()) return std::nullopt;
+    ProcStatus after;
+    if (!read_proc_status(m.pid, after)) {
+      fail("cannot read /proc/" + std::to_string(m.pid) + "/status");
+      return std::nullopt;
+    }
+    m.rss_mb = after.vm_rss;
+    m.hwm_mb = after.vm_hwm;
+    m.anon_mb = after.rss_anon;
+    m.file_mb = after.rss_file;
+    m.samples_sent = sent_;
+    m.samples_seen = static_cast<std::size_t>(seen_.seen);
+    m.samples_used = static_cast<std::size_t>(seen_.used);
+    child_.stop();
+    return m;
+  }
+
+ private:
+  bool write_files() {
+    const std::string plant_text = bench_plant_yaml(run_.n);
+    try {
+      plant_ = config::parse_plant(plant_text, "bench plant " + tag(run_.n));
+    } catch (const std::exception& e) {
+      why_ = e.what();
+      return false;
+    }
+    const int pid = static_cast<int>(::getpid());
+    controller_ = "bench-" + tag(run_.n);
+    // ttl=0 keeps it on this host; a port of our own (not mpmd's default
+    // 7667 nor the latency figure's 7671) and channels named after our pid.
+    lcm_.url = "udpm://239.255.76.67:" + std::to_string(7767 + pid % 1000) + "?ttl=0";
+    lcm_.sample_channel = "MPM_BENCH_SAMPLE_" + std::to_string(pid);
+    lcm_.alarm_channel = "MPM_BENCH_ALARM_" + std::to_string(pid);
+    lcm_.status_channel = "MPM_BENCH_STATUS_" + std::to_string(pid);
+    if (write_text(dir_.file("plant.yaml"), plant_text) &&
+        write_text(dir_.file("mpmd.yaml"), daemon_yaml(dir_.file("plant.yaml"), controller_, lcm_)))
+      return true;
+    why_ = "cannot write the plant and configuration files to " + dir_.file("");
+    return false;
+  }
+
+  bool open_transport() {
+    transport::Settings s;
+    s.kind = transport::Kind::kLcm;
+    s.lcm = lcm_;
+    transport_ = transport::create(s, why_);
+    if (!transport_) return false;
+    const bool ok = transport_->subscribe_status([this](const msg::Status& st) {
+      if (st.controller_id != controller_) return;
+      seen_.seen = st.samples_seen;
+      seen_.used = st.samples_used;
+    });
+    if (!ok) why_ = "cannot subscribe to mpmd's status on " + lcm_.url;
+    return ok;
+  }
+
+  // Stops mpmd and sets why_ to `what` and mpmd's last log line; false.
+  bool fail(const std::string& what) {
+    child_.stop();
+    why_ = what;
+    const std::string last = last_line(dir_.file("mpmd.log"));
+    if (!last.empty()) why_ += "; mpmd's last log line: " + last;
+    return false;
+  }
+
+  std::string died() { return "mpmd (" + run_.mpmd + ") " + describe_exit(*child_.exit_status()); }
+
+  bool wait_ready() {
+    const auto deadline = Clock::now() + run_.ready_timeout;
+    while (Clock::now() < deadline) {
+      if (notify_.receive("READY=1", std::chrono::milliseconds(100))) return true;
+      if (!child_.running()) return fail(died() + " before READY=1");
+    }
+    const double s = std::chrono::duration<double>(run_.ready_timeout).count();
+    char text[64];
+    std::snprintf(text, sizeof text, " sent no READY=1 within %.0f s", s);
+    return fail("mpmd (" + run_.mpmd + ")" + text);
+  }
+
+  // Publishes chunks of samples, each confirmed by a status, until the
+  // monitor has used run_.used of them.
+  bool feed() {
+    SampleSource source(plant_, controller_);
+    while (seen_.used < static_cast<std::int64_t>(run_.used)) {
+      if (sent_ >= run_.max_samples) {
+        return fail("after " + std::to_string(sent_) + " samples mpmd's monitor had used " +
+                    std::to_string(seen_.used) + ", not " + std::to_string(run_.used));
+      }
+      // Once samples are used, exactly as many as are still wanted.
+      std::size_t chunk = kChunk;
+      if (seen_.used > 0) chunk = std::min(chunk, run_.used - static_cast<std::size_t>(seen_.used));
+      chunk = std::min(chunk, run_.max_samples - sent_);
+      for (std::size_t k = 0; k < chunk; ++k) {
+        if (!transport_->publish(source.next())) return fail("could not publish a sample on " + lcm_.url);
+      }
+      sent_ += chunk;
+      if (!wait_seen(sent_)) return false;
+    }
+    return true;
+  }
+
+  bool wait_seen(std::size_t target) {
+    const auto deadline = Clock::now() + kChunkTimeout;
+    while (seen_.seen < static_cast<std::int64_t>(target)) {
+      if (transport_->handle(std::chrono::milliseconds(20)) < 0)
+        return fail("the LCM transport of the bench failed on " + lcm_.url);
+      if (!child_.running()) return fail(died() + " while processing samples");
+      if (Clock::now() >= deadline) {
+        return fail("mpmd's status confirmed " + std::to_string(std::max<std::int64_t>(seen_.seen, 0)) + " of " +
+                    std::to_string(target) + " samples sent on " + lcm_.url + " (multicast loopback blocked?)");
+      }
+    }
+    return true;
+  }
+
+  const MpmdRun& run_;
+  std::string& why_;
+  TempDir dir_;  // declared before the child: removed after it is stopped
+  NotifySocket notify_;
+  std::unique_ptr<transport::Transport> transport_;
+  Child child_;
+  PlantModel plant_;
+  std::string controller_;
+  transport::LcmSettings lcm_;
+  Seen seen_;
+  std::size_t sent_ = 0;
+};
+
+}  // namespace
+
+std::optional<MpmdMemory> measure_mpmd_memory(const MpmdRun& run, std::string& why) {
+  return Measurement(run, why).run();
+}
+
+#endif
 
 }  // namespace mpm::bench

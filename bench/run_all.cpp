@@ -2,6 +2,7 @@
 // many repetitions (full run well under 2 minutes, --quick a smoke test).
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench/alloc_hook.hpp"
@@ -48,21 +49,52 @@ class Plan {
   const BenchOptions& o_;
 };
 
-// First, while this process is still small: the forked child inherits it.
+// The real mpmd, started and fed samples over LCM (bench/memory.hpp). First,
+// while this process is still small: the forked child starts as a copy of it.
 void memory_figures(Plan& plan) {
-  for (std::size_t n : {std::size_t{2}, std::size_t{50}}) {
-    plan.say("resident memory of a process holding a " + tag(n) + " monitor");
-    std::string why;
-    const auto m = measure_monitor_memory(n, n, why);
+  std::string why;
+  const std::optional<std::string> mpmd = find_mpmd(own_exe_dir(), why);
+  std::optional<double> anon_2x2;
+  // Samples the monitor must have used (a 50x50 update takes ~50 ms); the
+  // first ~120 sent only fill its lags and settle its model filters.
+  const std::size_t used_50 = plan.quick() ? 20 : 60;
+  for (const auto& [n, used] : {std::pair<std::size_t, std::size_t>{2, 400}, {50, used_50}}) {
     const std::string name = "mpmd_rss_mb_" + tag(n);
-    if (!m) {
+    if (!mpmd) {
       plan.add(name, std::nullopt, "MB", why);
       continue;
     }
-    plan.add(name, m->rss_mb, "MB",
-             fmt("proxy: VmRSS of a forked bench process holding the monitor after updates "
-                 "(process before it: %.1f MB; VmHWM %.1f MB)",
-                 m->baseline_mb, m->hwm_mb));
+    plan.say("resident memory of mpmd monitoring a " + tag(n) + " plant (" + *mpmd + ")");
+    MpmdRun run;
+    run.mpmd = *mpmd;
+    run.n = n;
+    run.used = used;
+    std::string failed;
+    const std::optional<MpmdMemory> m = measure_mpmd_memory(run, failed);
+    if (!m) {
+      plan.add(name, std::nullopt, "MB", failed);
+      continue;
+    }
+    char text[768];
+    std::snprintf(text, sizeof text,
+                  "VmRSS of mpmd (pid %d, %s) monitoring a %s plant (%s; na=20 nb=10 lambda=0.999, "
+                  "model-filtered regressors, gamma on) after %zu samples over LCM (%s), all processed (its status: "
+                  "%zu seen, %zu used by the monitor); VmHWM %.1f MB; RssAnon %.1f MB (heap: monitor, models, "
+                  "queues, buffers), RssFile %.1f MB (executable, shared libraries); at READY=1, monitor built and "
+                  "no sample yet: VmRSS %.1f MB",
+                  static_cast<int>(m->pid), mpmd->c_str(), tag(n).c_str(),
+                  n == 2 ? "Wood-Berry" : "generated, first order plus dead time per channel", m->samples_sent,
+                  m->url.c_str(), m->samples_seen, m->samples_used, m->hwm_mb, m->anon_mb, m->file_mb,
+                  m->ready_rss_mb);
+    std::string note = text;
+    if (anon_2x2) {
+      std::snprintf(text, sizeof text, "; what grows with the plant (monitor, models): about %.1f MB (RssAnon "
+                                       "minus the 2x2 run's)",
+                    m->anon_mb - *anon_2x2);
+      note += text;
+    }
+    if (n == 2) anon_2x2 = m->anon_mb;
+    plan.add(name, m->rss_mb, "MB", note);
   }
 }
 
@@ -122,10 +154,14 @@ void replay_figure(Plan& plan, std::int64_t& allocations, std::size_t& updates) 
   const ReplayResult r = measure_replay(samples);
   allocations += r.allocations;
   updates += r.samples;
-  plan.add("replay_samples_per_s_2x2", r.samples_per_s, "samples/s",
-           fmt("%.0f-sample recording in memory (Wood-Berry, built-in plant) through ResidualGenerator + "
-               "GrangerMonitor (na=20 nb=10 lambda=0.999, gamma on), thread CPU time",
-               static_cast<double>(samples)));
+  plan.add("replay_samples_per_s_2x2", r.parallel_samples_per_s, "samples/s",
+           fmt("%.0f-sample recording in memory (Wood-Berry, built-in plant) replayed as `mpm monitor` does: "
+               "ResidualGenerator, then GrangerMonitor (na=20 nb=10 lambda=0.999, gamma on) with the outputs "
+               "split over %.0f threads, wall-clock time; statistics ",
+               static_cast<double>(samples), static_cast<double>(r.threads)) +
+               (r.parallel_identical ? "identical to the one-thread replay's" : "DIFFERENT FROM the one-thread replay's"));
+  plan.add("replay_samples_per_s_2x2_one_thread", r.samples_per_s, "samples/s",
+           "the same replay on one thread (residual and monitor per sample), thread CPU time");
 }
 
 void lcm_figures(Plan& plan) {
