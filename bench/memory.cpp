@@ -1,26 +1,22 @@
+// What is specific to measuring mpmd: finding it, the plant and
+// configuration it is given, the samples it is fed over LCM and the figures
+// read from it. Starting, notifying, reading /proc and stopping a child are
+// generic and live in bench/child_process.hpp.
 #include "bench/memory.hpp"
 
-#include <fcntl.h>
-#include <poll.h>
-#include <signal.h>
-#include <sys/prctl.h>
-#include <sys/socket.h>
-#include <sys/stat.h>
-#include <sys/un.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cerrno>
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <memory>
 #include <random>
 #include <sstream>
-#include <thread>
 #include <vector>
 
+#include "bench/child_process.hpp"
 #include "sim/builtin_plants.hpp"
 
 #ifdef MPM_BENCH_HAVE_TRANSPORT
@@ -29,20 +25,9 @@
 #include "transport/transport.hpp"
 #endif
 
-extern char** environ;
-
 namespace mpm::bench {
 
 namespace fs = std::filesystem;
-
-namespace {
-
-bool is_executable_file(const std::string& path) {
-  struct stat st {};
-  return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(path.c_str(), X_OK) == 0;
-}
-
-}  // namespace
 
 std::string own_exe_dir() {
   std::error_code ec;
@@ -115,197 +100,6 @@ using Clock = std::chrono::steady_clock;
 constexpr std::size_t kChunk = 50;
 // Longest wait for a chunk's confirmation (at 50x50 a used sample takes ~50 ms).
 constexpr std::chrono::seconds kChunkTimeout{60};
-
-// A fresh folder from mkdtemp, removed with everything in it on destruction.
-class TempDir {
- public:
-  bool make(std::string& why) {
-    std::error_code ec;
-    const fs::path base = fs::temp_directory_path(ec);
-    std::string pattern = ((ec ? fs::path("/tmp") : base) / "mpm-bench-XXXXXX").string();
-    if (::mkdtemp(pattern.data()) == nullptr) {
-      why = "mkdtemp(" + pattern + ") failed: " + std::strerror(errno);
-      return false;
-    }
-    path_ = pattern;
-    return true;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    if (!path_.empty()) fs::remove_all(path_, ec);
-  }
-  std::string file(const char* name) const { return path_ + "/" + name; }
-
- private:
-  std::string path_;
-};
-
-bool write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  return static_cast<bool>(out);
-}
-
-// The last non-empty line of a file (mpmd's stderr), "" if none.
-std::string last_line(const std::string& path) {
-  std::ifstream in(path);
-  std::string line, last;
-  while (std::getline(in, line)) {
-    if (!line.empty()) last = line;
-  }
-  return last;
-}
-
-// Fields of /proc/<pid>/status in MB (the file gives kB); 0 when absent.
-struct ProcStatus {
-  double vm_rss = 0.0, vm_hwm = 0.0, rss_anon = 0.0, rss_file = 0.0;
-};
-bool read_proc_status(pid_t pid, ProcStatus& s) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
-  if (!in) return false;
-  std::string line;
-  while (std::getline(in, line)) {
-    const auto colon = line.find(':');
-    if (colon == std::string::npos) continue;
-    const std::string key = line.substr(0, colon);
-    double* field = key == "VmRSS"     ? &s.vm_rss
-                    : key == "VmHWM"   ? &s.vm_hwm
-                    : key == "RssAnon" ? &s.rss_anon
-                    : key == "RssFile" ? &s.rss_file
-                                       : nullptr;
-    if (field) *field = std::strtod(line.c_str() + colon + 1, nullptr) / 1024.0;
-  }
-  return s.vm_rss > 0.0;
-}
-
-std::string describe_exit(int status) {
-  if (WIFEXITED(status)) return "exited with code " + std::to_string(WEXITSTATUS(status));
-  if (WIFSIGNALED(status)) return std::string("was killed by signal ") + strsignal(WTERMSIG(status));
-  return "stopped";
-}
-
-// The mpmd child: started with fork/exec, its stdout and stderr to one file;
-// stopped (SIGTERM, then SIGKILL) and reaped by stop() or the destructor.
-class Child {
- public:
-  explicit Child(std::chrono::milliseconds stop_timeout) : stop_timeout_(stop_timeout) {}
-  ~Child() { stop(); }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-
-  bool start(const std::vector<std::string>& args, const std::vector<std::string>& env, const std::string& log,
-             std::string& why) {
-    // Everything the child needs is made before fork: after it, only
-    // async-signal-safe calls.
-    std::vector<char*> argv, envp;
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    for (const auto& e : env) envp.push_back(const_cast<char*>(e.c_str()));
-    envp.push_back(nullptr);
-    const int out = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    const int in = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
-    if (out < 0 || in < 0) {
-      why = "cannot open " + log + " or /dev/null: " + std::strerror(errno);
-      if (out >= 0) ::close(out);
-      if (in >= 0) ::close(in);
-      return false;
-    }
-    const pid_t parent = ::getpid();
-    std::fflush(nullptr);
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      // Dies with us even if we are killed before stopping it.
-      ::prctl(PR_SET_PDEATHSIG, SIGTERM);
-      if (::getppid() != parent) ::_exit(126);
-      ::dup2(in, 0);
-      ::dup2(out, 1);
-      ::dup2(out, 2);
-      ::close_range(3, ~0U, 0);  // no LCM socket or notify socket of ours in mpmd
-      ::execve(argv[0], argv.data(), envp.data());
-      constexpr char kFailed[] = "<3>mpm bench: execve of mpmd failed\n";
-      [[maybe_unused]] const ssize_t n = ::write(2, kFailed, sizeof kFailed - 1);
-      ::_exit(127);
-    }
-    const int fork_errno = errno;
-    ::close(out);
-    ::close(in);
-    if (pid_ < 0) {
-      why = std::string("fork failed: ") + std::strerror(fork_errno);
-      return false;
-    }
-    return true;
-  }
-
-  pid_t pid() const { return pid_; }
-
-  // False once it has exited (then exit_status() says how).
-  bool running() {
-    if (pid_ <= 0 || status_) return false;
-    int status = 0;
-    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-      status_ = status;
-      return false;
-    }
-    return true;
-  }
-  std::optional<int> exit_status() const { return status_; }
-
-  // SIGTERM, up to stop_timeout for it to exit, then SIGKILL; always reaped.
-  void stop() {
-    if (!running()) return;
-    ::kill(pid_, SIGTERM);
-    const auto deadline = Clock::now() + stop_timeout_;
-    while (running() && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    if (!running()) return;
-    ::kill(pid_, SIGKILL);
-    int status = 0;
-    while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
-    }
-    status_ = status;
-  }
-
- private:
-  std::chrono::milliseconds stop_timeout_;
-  pid_t pid_ = -1;
-  std::optional<int> status_;
-};
-
-// The systemd side of sd_notify: a datagram socket bound to a path that the
-// child finds in NOTIFY_SOCKET.
-class NotifySocket {
- public:
-  ~NotifySocket() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  bool bind(const std::string& path, std::string& why) {
-    sockaddr_un addr{};
-    if (path.size() >= sizeof addr.sun_path) {
-      why = "notify socket path too long: " + path;
-      return false;
-    }
-    fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    addr.sun_family = AF_UNIX;
-    std::memcpy(addr.sun_path, path.c_str(), path.size() + 1);
-    if (fd_ < 0 || ::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
-      why = "cannot bind the notify socket " + path + ": " + std::strerror(errno);
-      return false;
-    }
-    return true;
-  }
-  // Waits up to `wait` for a datagram; true when one containing `needle` came.
-  bool receive(const char* needle, std::chrono::milliseconds wait) {
-    pollfd p{fd_, POLLIN, 0};
-    if (::poll(&p, 1, static_cast<int>(wait.count())) <= 0) return false;
-    char buf[1024];
-    const ssize_t n = ::recv(fd_, buf, sizeof buf - 1, MSG_DONTWAIT);
-    if (n <= 0) return false;
-    buf[n] = '\0';
-    return std::strstr(buf, needle) != nullptr;
-  }
-
- private:
-  int fd_ = -1;
-};
 
 // Samples as a controller would publish them for a matched plant:
 // y = y0 + G_M (u - u0) + d, u white around u0, d of the plant's first-order
@@ -387,18 +181,6 @@ std::string daemon_yaml(const std::string& plant_path, const std::string& contro
          "log_interval: 3600\n";
 }
 
-// Our environment, with NOTIFY_SOCKET ours and no systemd watchdog.
-std::vector<std::string> child_environment(const std::string& notify_path) {
-  std::vector<std::string> env;
-  for (char** e = environ; e != nullptr && *e != nullptr; ++e) {
-    const std::string entry = *e;
-    if (entry.rfind("NOTIFY_SOCKET=", 0) == 0 || entry.rfind("WATCHDOG_", 0) == 0) continue;
-    env.push_back(entry);
-  }
-  env.push_back("NOTIFY_SOCKET=" + notify_path);
-  return env;
-}
-
 // What the last status of our controller said.
 struct Seen {
   std::int64_t seen = -1;
@@ -412,30 +194,30 @@ class Measurement {
   std::optional<MpmdMemory> run() {
     if (!dir_.make(why_) || !write_files() || !open_transport() || !notify_.bind(dir_.file("notify.sock"), why_))
       return std::nullopt;
-    if (!child_.start({run_.mpmd, "--config", dir_.file("mpmd.yaml")}, child_environment(dir_.file("notify.sock")),
-                      dir_.file("mpmd.log"), why_))
+    if (!child_.start({run_.mpmd, "--config", dir_.file("mpmd.yaml")},
+                      environment_with_notify_socket(dir_.file("notify.sock")), dir_.file("mpmd.log"), why_))
       return std::nullopt;
     MpmdMemory m;
     m.pid = child_.pid();
     m.url = lcm_.url;
     if (!wait_ready()) return std::nullopt;
-    ProcStatus at_ready;
-    if (!read_proc_status(m.pid, at_ready)) {
+    const std::optional<ProcMemory> at_ready = read_proc_memory(m.pid);
+    if (!at_ready) {
       fail("cannot read /proc/" + std::to_string(m.pid) + "/status");
       return std::nullopt;
     }
-    m.ready_rss_mb = at_ready.vm_rss;
-    m.ready_anon_mb = at_ready.rss_anon;
+    m.ready_rss_mb = at_ready->vm_rss_mb;
+    m.ready_anon_mb = at_ready->rss_anon_mb;
     if (!feed()) return std::nullopt;
-    ProcStatus after;
-    if (!read_proc_status(m.pid, after)) {
+    const std::optional<ProcMemory> after = read_proc_memory(m.pid);
+    if (!after) {
       fail("cannot read /proc/" + std::to_string(m.pid) + "/status");
       return std::nullopt;
     }
-    m.rss_mb = after.vm_rss;
-    m.hwm_mb = after.vm_hwm;
-    m.anon_mb = after.rss_anon;
-    m.file_mb = after.rss_file;
+    m.rss_mb = after->vm_rss_mb;
+    m.hwm_mb = after->vm_hwm_mb;
+    m.anon_mb = after->rss_anon_mb;
+    m.file_mb = after->rss_file_mb;
     m.samples_sent = sent_;
     m.samples_seen = static_cast<std::size_t>(seen_.seen);
     m.samples_used = static_cast<std::size_t>(seen_.used);
@@ -460,8 +242,8 @@ class Measurement {
     lcm_.sample_channel = "MPM_BENCH_SAMPLE_" + std::to_string(pid);
     lcm_.alarm_channel = "MPM_BENCH_ALARM_" + std::to_string(pid);
     lcm_.status_channel = "MPM_BENCH_STATUS_" + std::to_string(pid);
-    if (write_text(dir_.file("plant.yaml"), plant_text) &&
-        write_text(dir_.file("mpmd.yaml"), daemon_yaml(dir_.file("plant.yaml"), controller_, lcm_)))
+    if (write_text_file(dir_.file("plant.yaml"), plant_text) &&
+        write_text_file(dir_.file("mpmd.yaml"), daemon_yaml(dir_.file("plant.yaml"), controller_, lcm_)))
       return true;
     why_ = "cannot write the plant and configuration files to " + dir_.file("");
     return false;
@@ -486,7 +268,7 @@ class Measurement {
   bool fail(const std::string& what) {
     child_.stop();
     why_ = what;
-    const std::string last = last_line(dir_.file("mpmd.log"));
+    const std::string last = last_nonempty_line(dir_.file("mpmd.log"));
     if (!last.empty()) why_ += "; mpmd's last log line: " + last;
     return false;
   }
@@ -494,10 +276,13 @@ class Measurement {
   std::string died() { return "mpmd (" + run_.mpmd + ") " + describe_exit(*child_.exit_status()); }
 
   bool wait_ready() {
-    const auto deadline = Clock::now() + run_.ready_timeout;
-    while (Clock::now() < deadline) {
-      if (notify_.receive("READY=1", std::chrono::milliseconds(100))) return true;
-      if (!child_.running()) return fail(died() + " before READY=1");
+    switch (wait_for_ready(notify_, child_, run_.ready_timeout)) {
+      case ReadyWait::kReady:
+        return true;
+      case ReadyWait::kExited:
+        return fail(died() + " before READY=1");
+      case ReadyWait::kTimedOut:
+        break;
     }
     const double s = std::chrono::duration<double>(run_.ready_timeout).count();
     char text[64];
@@ -543,10 +328,12 @@ class Measurement {
 
   const MpmdRun& run_;
   std::string& why_;
-  TempDir dir_;  // declared before the child: removed after it is stopped
+  // Declared before the socket and the child: removed after they are closed
+  // and stopped (members are destroyed in reverse order).
+  TempDir dir_;
   NotifySocket notify_;
   std::unique_ptr<transport::Transport> transport_;
-  Child child_;
+  ChildProcess child_;
   PlantModel plant_;
   std::string controller_;
   transport::LcmSettings lcm_;
