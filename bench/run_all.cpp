@@ -8,10 +8,12 @@
 #include "bench/alloc_hook.hpp"
 #include "bench/batch_baseline.hpp"
 #include "bench/cpu_clock.hpp"
+#include "bench/diagnose_throughput.hpp"
 #include "bench/figures.hpp"
 #include "bench/flops.hpp"
 #include "bench/lcm_latency.hpp"
 #include "bench/memory.hpp"
+#include "bench/limits.hpp"
 #include "bench/replay.hpp"
 #include "bench/update_timing.hpp"
 #include "bench/workload.hpp"
@@ -126,6 +128,44 @@ void update_figures(Plan& plan, const PeakRate& peak, std::int64_t& allocations,
   }
 }
 
+// What bounds the update from below (bench/limits.hpp), beside the update
+// times measured above: the dependent chain of rotations at 2x2, the bytes
+// of state streamed at 50x50.
+void limit_figures(Plan& plan) {
+  const MonitorSettings s = paper_settings();
+  const auto measured = [&](const std::string& name) -> std::optional<double> {
+    for (const Figure& f : plan.figures)
+      if (f.name == name) return f.value;
+    return std::nullopt;
+  };
+  plan.say("latency of one rotation step (dependent sqrt + divide)");
+  const double step_ns = measure_sqrt_div_step_ns(plan.quick() ? 0.02 : 0.2);
+  const std::size_t chain = rotation_chain_length(2, s);
+  plan.add("rotation_step_ns", step_ns, "ns",
+           "measured: dependent chain r <- 1/sqrt(r r + c), the part of a Givens rotation the next one waits on");
+  const auto update_2x2 = measured("update_ns_2x2");
+  plan.add("latency_floor_ns_2x2", static_cast<double>(chain) * step_ns, "ns",
+           fmt("%.0f dependent rotations per output (the rows of [1, AR], then the inputs' factor) x rotation_step_ns; "
+               "the two outputs' chains overlap, everything else must hide under them (update_ns_2x2 = %.2f x this)",
+               static_cast<double>(chain), update_2x2 ? *update_2x2 / (static_cast<double>(chain) * step_ns) : 0.0));
+
+  const double state = state_bytes_per_update(50, 50, s);
+  plan.add("state_mb_per_update_50x50", state / (1024.0 * 1024.0), "MB",
+           "analytic (bench/limits.hpp): factor storage one update reads and writes back, triangles where only "
+           "triangles are touched");
+  plan.say("streaming rate over a working set of that size");
+  const StreamRate stream = measure_stream_rate(state, plan.quick() ? 0.05 : 0.5);
+  plan.add("stream_gb_per_s", stream.bytes_per_s * 1e-9, "GB/s",
+           fmt("measured: read-modify-write passes over %.0f MB (2 reads + 1 write per element), one thread, best pass",
+               stream.working_set / (1024.0 * 1024.0)));
+  const auto update_50 = measured("update_ns_50x50");
+  const double floor_ms = 2.0 * state / stream.bytes_per_s * 1e3;
+  plan.add("memory_floor_ms_50x50", floor_ms, "ms",
+           fmt("2 x state_mb_per_update_50x50 / stream_gb_per_s: the time to read and write the state once "
+               "(update_ns_50x50 = %.2f x this)",
+               update_50 ? *update_50 * 1e-6 / floor_ms : 0.0));
+}
+
 void batch_figures(Plan& plan) {
   plan.say("sliding-window batch QR at 2x2 (window 2000)");
   const MonitorSettings s = paper_settings();
@@ -164,6 +204,40 @@ void replay_figure(Plan& plan, std::int64_t& allocations, std::size_t& updates) 
            "the same replay on one thread (residual and monitor per sample), thread CPU time");
 }
 
+// `mpm diagnose` end to end on a recording with a planted mismatch: only a
+// diagnosis that names the planted channel gives a figure.
+void diagnose_figure(Plan& plan) {
+  const std::size_t samples = plan.quick() ? 3000 : 50000;
+  const std::size_t repeats = plan.quick() ? 1 : 3;
+  plan.say("mpm diagnose pipeline on " + std::to_string(samples) + " closed-loop Wood-Berry samples");
+  const std::string name = "diagnose_samples_per_s_2x2";
+  std::string why;
+  const std::optional<DiagnoseThroughput> d = measure_diagnose(samples, repeats, why);
+  if (!d) {
+    plan.add(name, std::nullopt, "samples/s", why);
+    return;
+  }
+  char text[1024];
+  std::snprintf(text, sizeof text,
+                "%zu-sample closed-loop recording of scenario %s (seed 1; built-in wood-berry.yaml) written to "
+                "temporary files, then diagnosed as `mpm diagnose --quiet` does, by the same library calls in this "
+                "process (not the mpm binary; its problem set-up copied from daemon/cmd_diagnose.cpp): load and "
+                "parse plant YAML and CSV, bind, residuals, Granger monitor (forgetting 1) over %zu threads, "
+                "structured hypotheses (core/diagnosis.hpp); JSON report not timed; wall-clock, median of %zu "
+                "runs (fastest %.0f samples/s; %.2f s wall, %.2f s process CPU)",
+                d->samples, d->scenario.c_str(), d->threads, d->repeats, d->fastest_samples_per_s, d->wall_seconds,
+                d->cpu_seconds);
+  std::string note = text;
+  if (!d->found_planted) {
+    plan.add(name, std::nullopt, "samples/s",
+             "the diagnosis did not name the planted channel " + d->planted + " (found: " + d->findings +
+                 "), so its time is no figure; it ran at " + fmt("%.0f", d->samples_per_s) + " samples/s. " + note);
+    return;
+  }
+  plan.add(name, d->samples_per_s, "samples/s",
+           note + "; the diagnosis named the planted channel " + d->planted + ": " + d->findings);
+}
+
 void lcm_figures(Plan& plan) {
   const std::size_t messages = plan.quick() ? 100 : 2000;
   plan.say("LCM loopback latency (" + std::to_string(messages) + " messages)");
@@ -194,8 +268,10 @@ std::vector<Figure> run_all(const BenchOptions& options) {
   std::int64_t allocations = 0;
   std::size_t updates = 0;
   update_figures(plan, peak, allocations, updates);
+  limit_figures(plan);
   batch_figures(plan);
   replay_figure(plan, allocations, updates);
+  diagnose_figure(plan);
   plan.add("allocations_per_update", static_cast<double>(allocations) / static_cast<double>(updates), "",
            fmt("%.0f heap allocations over %.0f timed updates and replay samples (operator new",
                static_cast<double>(allocations), static_cast<double>(updates)) +

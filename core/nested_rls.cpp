@@ -12,6 +12,11 @@ namespace {
 // Lower factors updated together (SqrtRls::update_staged): enough
 // independent rotation chains to hide the square-root and division latency.
 constexpr std::size_t kLockstep = 8;
+// Factors with more regressors than this are updated alone: their rows are
+// long enough to hide the latency by themselves, and one factor at a time
+// walks its rows in memory order (a stream the prefetchers follow) instead
+// of hopping between eight factors' short row segments.
+constexpr std::size_t kLockstepMaxRegressors = 64;
 
 }  // namespace
 
@@ -106,6 +111,11 @@ void NestedRls::update_staged(NestedRls* models, std::size_t count) noexcept {
   SqrtRls* group[kLockstep];
   std::size_t in_group = 0;
   const auto add = [&](SqrtRls& lower) {
+    if (lower.n_regressors() > kLockstepMaxRegressors) {
+      SqrtRls* alone = &lower;
+      SqrtRls::update_staged(&alone, 1);
+      return;
+    }
     group[in_group++] = &lower;
     if (in_group == kLockstep) {
       SqrtRls::update_staged(group, in_group);

@@ -76,8 +76,8 @@ TEST_F(MpmBench, HasEveryFigureOfTheIssueWithAValueOrAReason) {
   const Parsed p = parse(*json_);
   for (const char* name : {"update_ns_2x2", "update_ns_4x4", "update_ns_20x20", "update_ns_50x50", "batch_ns_2x2",
                            "batch_ratio_2x2", "allocations_per_update", "peak_fraction_50x50",
-                           "replay_samples_per_s_2x2", "lcm_latency_p50_us", "lcm_latency_p99_us", "mpmd_rss_mb_2x2",
-                           "mpmd_rss_mb_50x50"}) {
+                           "replay_samples_per_s_2x2", "diagnose_samples_per_s_2x2", "lcm_latency_p50_us",
+                           "lcm_latency_p99_us", "mpmd_rss_mb_2x2", "mpmd_rss_mb_50x50"}) {
     SCOPED_TRACE(name);
     ASSERT_TRUE(p.values.count(name));
     if (!p.values.at(name)) {
@@ -95,11 +95,23 @@ TEST_F(MpmBench, MonitorUpdatesAllocateNothing) {
 
 TEST_F(MpmBench, MeasuredTimesArePositive) {  // not a timing assertion: a zero would mean nothing ran
   const Parsed p = parse(*json_);
-  for (const char* name : {"update_ns_2x2", "update_ns_50x50", "batch_ns_2x2", "replay_samples_per_s_2x2"}) {
+  for (const char* name :
+       {"update_ns_2x2", "update_ns_50x50", "batch_ns_2x2", "replay_samples_per_s_2x2", "diagnose_samples_per_s_2x2"}) {
     SCOPED_TRACE(name);
     ASSERT_TRUE(p.values.count(name) && p.values.at(name).has_value());
     EXPECT_GT(*p.values.at(name), 0.0);
   }
+}
+
+// The diagnose throughput is of a diagnosis that worked: `mpm bench` gives it
+// a value only when the findings name the channel the scenario planted
+// (wood-berry-g21-gain: y2 <- u1), and says so in the note.
+TEST_F(MpmBench, DiagnoseFigureIsOfADiagnosisThatFoundThePlantedChannel) {
+  const Parsed p = parse(*json_);
+  ASSERT_TRUE(p.values.count("diagnose_samples_per_s_2x2"));
+  const std::string& note = p.notes.at("diagnose_samples_per_s_2x2");
+  ASSERT_TRUE(p.values.at("diagnose_samples_per_s_2x2").has_value()) << note;
+  EXPECT_NE(note.find("named the planted channel y2 <- u1"), std::string::npos) << note;
 }
 
 }  // namespace

@@ -1,0 +1,218 @@
+#include "bench/diagnose_throughput.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include "config/plant_loader.hpp"
+#include "core/diagnosis.hpp"
+#include "core/granger_monitor.hpp"
+#include "daemon/offline.hpp"
+#include "sim/builtin_plants.hpp"
+#include "sim/closed_loop.hpp"
+#include "sim/scenarios.hpp"
+
+namespace mpm::bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kScenario = "wood-berry-g21-gain";
+
+// A fresh folder from mkdtemp, removed with everything in it on destruction.
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::error_code ec;
+    const fs::path base = fs::temp_directory_path(ec);
+    std::string pattern = ((ec ? fs::path("/tmp") : base) / "mpm-bench-diagnose-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr)
+      throw std::runtime_error("mkdtemp(" + pattern + ") failed: " + std::strerror(errno));
+    path_ = pattern;
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  std::string file(const char* name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+};
+
+double process_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// The diagnosis problem as daemon/cmd_diagnose.cpp sets it up (its
+// make_problem, which lives in that command's anonymous namespace): deviation
+// inputs with the last good value held over missing samples, the residual
+// series, the recording's extra columns, the plant's channels and noise
+// models, and the monitor's verdict.
+diagnosis::Problem make_problem(const PlantModel& plant, const config::Recording& rec,
+                                const config::BoundRecording& bound, const ResidualSeries& series,
+                                const RecordVerdict& verdict) {
+  diagnosis::Problem p;
+  p.inputs = plant.inputs;
+  p.outputs = plant.outputs;
+  p.sample_time = plant.sample_time;
+  const Eigen::Index n = series.u.rows(), m = series.u.cols();
+  std::vector<double> u0(static_cast<std::size_t>(m), 0.0);
+  if (plant.operating_point) {
+    u0 = plant.operating_point->inputs;
+  } else {
+    for (Eigen::Index k = 0; k < n; ++k)
+      if (series.u.row(k).allFinite()) {
+        for (Eigen::Index i = 0; i < m; ++i) u0[static_cast<std::size_t>(i)] = series.u(k, i);
+        break;
+      }
+  }
+  p.u_abs = series.u;
+  p.du.resize(n, m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    double last = u0[static_cast<std::size_t>(i)];
+    for (Eigen::Index k = 0; k < n; ++k) {
+      if (std::isfinite(series.u(k, i))) last = series.u(k, i);
+      p.du(k, i) = last - u0[static_cast<std::size_t>(i)];
+    }
+  }
+  p.residual = series.residual;
+  p.begin = series.transient;
+  for (std::size_t c : bound.extra) p.extra_names.push_back(rec.names[c]);
+  p.extra.resize(n, static_cast<Eigen::Index>(bound.extra.size()));
+  for (std::size_t c = 0; c < bound.extra.size(); ++c)
+    p.extra.col(static_cast<Eigen::Index>(c)) = rec.data.col(static_cast<Eigen::Index>(bound.extra[c]));
+  p.nominal = channel_models(plant);
+  p.noise.resize(plant.n_outputs());
+  p.noise_variance.resize(plant.n_outputs());
+  for (std::size_t j = 0; j < plant.n_outputs() && j < plant.noise.size(); ++j)
+    if (plant.noise[j]) {
+      p.noise[j] = plant.noise[j]->tf;
+      p.noise_variance[j] = plant.noise[j]->variance;
+    }
+  p.monitor_flag = verdict.loop_mismatch;
+  p.monitor_located.resize(plant.n_outputs());
+  for (const auto& [j, i] : verdict.located) p.monitor_located[j].push_back(i);
+  return p;
+}
+
+// `mpm diagnose --quiet --plant PLANT --data DATA` up to the report: what the
+// command does before it formats the JSON (not timed: a few kB of text).
+diagnosis::Result diagnose_files(const std::string& plant_path, const std::string& data_path, std::size_t& threads) {
+  const PlantModel plant = config::load_plant(plant_path);
+  const config::Recording rec = config::load_recording(data_path);
+  const config::BoundRecording bound = config::bind(plant, rec);
+  const ResidualSeries series = compute_residuals(plant, rec, bound);
+
+  MonitorSettings settings;
+  settings.forgetting = 1.0;
+  const auto noise = noise_ar(plant, settings.ar_order);
+  const auto reference = reference_variances(plant);
+  const auto channels = channel_models(plant);
+  const auto make = [&](OutputRange outputs) {
+    return GrangerMonitor(plant.n_inputs(), plant.n_outputs(), settings, noise, reference, channels, outputs);
+  };
+  GrangerMonitor monitor = make(OutputRange{});
+  threads = replay_threads(plant.n_outputs());
+  run_monitor_parallel(monitor, series, threads, make);
+  const RecordVerdict verdict = record_verdict(monitor);
+
+  const diagnosis::Problem problem = make_problem(plant, rec, bound, series, verdict);
+  return diagnosis::diagnose(problem, diagnosis::Settings{}, nullptr);
+}
+
+std::size_t index_of(const std::vector<std::string>& names, const std::string& name) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end())
+    throw std::runtime_error("scenario " + std::string(kScenario) + " edits unknown signal " + name);
+  return static_cast<std::size_t>(it - names.begin());
+}
+
+bool names_channel(const diagnosis::Result& r, std::size_t output, std::size_t input) {
+  for (const auto& f : r.findings)
+    for (const auto& c : f.channels)
+      if (c.output == output && c.input && *c.input == input) return true;
+  return false;
+}
+
+}  // namespace
+
+std::optional<DiagnoseThroughput> measure_diagnose(std::size_t samples, std::size_t repeats, std::string& why) {
+  try {
+    const sim::Scenario* scenario = sim::find_scenario(kScenario);
+    if (!scenario) throw std::runtime_error(std::string("no scenario ") + kScenario);
+    // The shipped plant file, as built into the binary: the same text whether
+    // or not a source tree or an installed share/ is around.
+    const auto plant_text = sim::builtin_plant_text(scenario->plant_file);
+    if (!plant_text) throw std::runtime_error("no built-in " + scenario->plant_file);
+    const PlantModel model = config::parse_plant(std::string(*plant_text), scenario->plant_file + " (built in)");
+
+    DiagnoseThroughput r;
+    r.scenario = scenario->name;
+    r.samples = samples;
+    r.repeats = std::max<std::size_t>(1, repeats);
+    std::vector<std::pair<std::size_t, std::size_t>> planted;  // (output, input)
+    for (const auto& e : scenario->loop.plant.channels) {
+      planted.emplace_back(index_of(model.outputs, e.output), index_of(model.inputs, e.input));
+      r.planted += (r.planted.empty() ? "" : ", ") + e.output + " <- " + e.input;
+    }
+    if (planted.empty()) throw std::runtime_error("scenario " + scenario->name + " plants no channel mismatch");
+
+    const ScratchDir dir;
+    const std::string plant_path = dir.file("plant.yaml");
+    const std::string data_path = dir.file("run.csv");
+    {
+      std::ofstream f(plant_path);
+      f << *plant_text;
+      if (!f) throw std::runtime_error("cannot write " + plant_path);
+    }
+    {
+      sim::ClosedLoop loop(model, scenario->loop, 1);
+      config::write_recording(data_path, sim::simulate(loop, samples, data_path));
+    }
+
+    struct Run {
+      double wall, cpu;
+    };
+    std::vector<Run> runs;
+    r.found_planted = true;
+    for (std::size_t k = 0; k < r.repeats; ++k) {
+      const double cpu0 = process_cpu_seconds();
+      const auto t0 = std::chrono::steady_clock::now();
+      const diagnosis::Result result = diagnose_files(plant_path, data_path, r.threads);
+      const auto t1 = std::chrono::steady_clock::now();
+      runs.push_back({std::chrono::duration<double>(t1 - t0).count(), process_cpu_seconds() - cpu0});
+      for (const auto& [j, i] : planted) r.found_planted = r.found_planted && names_channel(result, j, i);
+      if (k == 0) {
+        for (const auto& f : result.findings) r.findings += (r.findings.empty() ? "" : "; ") + f.summary;
+        if (result.findings.empty()) r.findings = "no finding";
+      }
+    }
+    std::sort(runs.begin(), runs.end(), [](const Run& a, const Run& b) { return a.wall < b.wall; });
+    const Run& median = runs[runs.size() / 2];
+    r.wall_seconds = median.wall;
+    r.cpu_seconds = median.cpu;
+    r.samples_per_s = static_cast<double>(samples) / median.wall;
+    r.fastest_samples_per_s = static_cast<double>(samples) / runs.front().wall;
+    return r;
+  } catch (const std::exception& e) {
+    why = std::string("diagnose throughput not measured: ") + e.what();
+    return std::nullopt;
+  }
+}
+
+}  // namespace mpm::bench
