@@ -17,13 +17,25 @@ OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std:
   const OutputState& o = cx.out[j];
   OutputFit f;
   f.output = j;
-  Vec target = c0.size() ? Vec(o.wd - simulate(o.whitener, c0)) : o.wd;
+  const bool joint = !o.signals.empty();
+  const Vec& w0 = joint ? o.wbase : o.wd;
+  Vec target = c0.size() ? Vec(w0 - simulate(o.whitener, c0)) : w0;
   std::vector<Vec> regs;
-  regs.reserve(X.size());
+  regs.reserve(X.size() + o.wsignals.size());
   for (const Vec& x : X) regs.push_back(simulate(o.whitener, x));
+  if (joint) regs.insert(regs.end(), o.wsignals.begin(), o.wsignals.end());
   f.fit = least_squares(target, regs, cx.seg);
   f.correction = c0.size() ? c0 : Vec::Zero(o.d.size());
   for (std::size_t l = 0; l < X.size(); ++l) f.correction += f.fit.theta(static_cast<Index>(l)) * X[l];
+  f.regressors = X;
+  if (joint) {
+    const auto nx = static_cast<Index>(X.size()), ns = static_cast<Index>(o.signals.size());
+    f.signal_theta = f.fit.theta.segment(nx, ns);
+    for (Index s = 0; s < ns; ++s)
+      f.correction += (f.signal_theta(s) - o.signal_theta(s)) * o.signals[static_cast<std::size_t>(s)];
+    f.fit.theta.conservativeResize(nx);
+    f.fit.theta_se.conservativeResize(nx);
+  }
   return f;
 }
 
@@ -56,11 +68,19 @@ void score(const Context& cx, Candidate& c) {
 
 namespace {
 
-// Whitened variances and held-out errors of output j as it stands.
+// Whitened variances and held-out errors of output j as it stands: its
+// process-corrected residual less the signals-only fit of its accepted
+// recorded signals.
 void refresh(Context& cx, std::size_t j) {
   OutputState& o = cx.out[j];
+  o.wbase = simulate(o.whitener, o.base);
+  o.wsignals.resize(o.signals.size());
+  for (std::size_t s = 0; s < o.signals.size(); ++s) o.wsignals[s] = simulate(o.whitener, o.signals[s]);
+  const LinearFit f = least_squares(o.wbase, o.wsignals, cx.seg);
+  o.signal_theta = f.theta;
+  o.d = o.base;
+  for (std::size_t s = 0; s < o.signals.size(); ++s) o.d -= f.theta(static_cast<Index>(s)) * o.signals[s];
   o.wd = simulate(o.whitener, o.d);
-  const LinearFit f = least_squares(o.wd, {}, cx.seg);
   o.fit_var = f.fit_var;
   o.hold_var = f.hold_var;
   o.hold_error = f.hold_error;
@@ -234,6 +254,7 @@ Context prepare(const Problem& p, const Settings& s) {
       const Arx a = arx(cx, o.d, s.ar_order, blocks);
       o.whitener = DiscreteTf{a.ar, {1.0}, 0};
     }
+    o.base = o.d;
     refresh(cx, j);
   }
   return cx;
@@ -321,7 +342,11 @@ void disturbance_models(Context& cx, const std::vector<bool>& explained, Result&
       const Vec e = simulate(DiscreteTf{a, {1.0}, 0}, o.wd);
       const LinearFit f = least_squares(e, {}, cx.seg);
       Candidate c;
-      c.fits.push_back(OutputFit{j, Vec::Zero(o.d.size()), f});
+      OutputFit of;
+      of.output = j;
+      of.correction = Vec::Zero(o.d.size());
+      of.fit = f;
+      c.fits.push_back(std::move(of));
       c.params = k;
       score(cx, c);
       if (c.lr < chi_square_quantile_upper(limit_alpha, k) || c.z_hold < cx.settings.holdout_z || c.hold_gain <= 0.0) continue;
@@ -413,7 +438,19 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
       for (std::size_t c = 0; c < problem.extra_names.size(); ++c)
         if (problem.extra_names[c] == *f.signal) used_signals.insert({f.channels[0].output, c});
     for (const auto& of : best->fits) {
-      cx.out[of.output].d -= of.correction;
+      // The finding's own correction leaves the residual; a recorded signal
+      // instead joins the output's free signal regressors.
+      OutputState& o = cx.out[of.output];
+      Vec own = of.correction;
+      for (Index s = 0; s < of.signal_theta.size(); ++s)
+        own -= (of.signal_theta(s) - o.signal_theta(s)) * o.signals[static_cast<std::size_t>(s)];
+      if (f.signal) {
+        for (std::size_t l = 0; l < of.regressors.size(); ++l) {
+          own -= of.fit.theta(static_cast<Index>(l)) * of.regressors[l];
+          o.signals.push_back(of.regressors[l]);
+        }
+      }
+      o.base -= own;
       refresh(cx, of.output);
     }
     r.findings.push_back(std::move(f));

@@ -16,7 +16,12 @@
 // pass a likelihood-ratio test there (chi-square, Bonferroni over all the
 // candidates tried) and improve the prediction on the held-out part
 // (the other three blocks), which it never saw. Candidates are chosen greedily: the best by BIC is
-// accepted, its correction is subtracted, and the rest are refitted.
+// accepted, its correction is subtracted, and the rest are refitted. Recorded
+// signals accepted as unmodeled inputs of an output stay free regressors of
+// that output: every later hypothesis there is fitted jointly with them and
+// tested against the signals-only fit, so it must earn its place conditional
+// on them (the controller moves the inputs to cancel them, so G_M u is
+// correlated with them).
 #pragma once
 
 #include <cstddef>

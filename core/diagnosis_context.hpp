@@ -11,10 +11,22 @@
 namespace mpm::diagnosis {
 
 // One output's current residual and its whitener.
+// Recorded signals accepted as unmodeled inputs of this output stay free in
+// every later fit: each hypothesis is fitted jointly with their regressors,
+// and is scored against the signals-only fit, so a process-channel finding
+// must improve the fit conditional on the accepted signals (in closed loop the
+// controller moves the inputs to cancel them, so G_M u is correlated with
+// them, and a correction fitted after a fixed subtraction would take up the
+// error of the signals' coefficients).
 struct OutputState {
   Vec d;               // residual with accepted corrections subtracted (missing: held)
   DiscreteTf whitener; // N^-1, or the AR part of an ARX fit
   Vec wd;              // whitener applied to d
+  Vec base;            // residual with accepted process corrections subtracted, signals not
+  Vec wbase;           // whitener applied to base
+  std::vector<Vec> signals;   // regressors of the accepted recorded signals (raw)
+  std::vector<Vec> wsignals;  // whitened
+  Vec signal_theta;           // their coefficients in the signals-only fit: d = base - sum theta signal
   double fit_var = 1.0;   // whitened variance now, fit part
   double hold_var = 1.0;  // whitened variance now, held-out part
   Vec hold_error;         // whitened, mean-removed errors on the held-out part
@@ -43,8 +55,10 @@ struct Context {
 // The fit of one output under a hypothesis: correction c = c0 + sum theta x.
 struct OutputFit {
   std::size_t output = 0;
-  Vec correction;   // raw, full length
-  LinearFit fit;    // whitened
+  Vec correction;   // raw, full length: the change of d (with the signals' refitted coefficients)
+  LinearFit fit;    // whitened; theta holds the hypothesis' own coefficients only
+  std::vector<Vec> regressors;  // the hypothesis' linear regressors X (raw)
+  Vec signal_theta;             // the accepted signals' coefficients in the joint fit
 };
 
 struct Candidate {
@@ -57,7 +71,8 @@ struct Candidate {
   double bic(double log_n) const;  // lr - params ln n
 };
 
-// Fits output j with fixed correction c0 (may be empty) plus linear terms X.
+// Fits output j with fixed correction c0 (may be empty) plus linear terms X,
+// jointly with the output's accepted signal regressors.
 OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std::vector<Vec>& X);
 // -sum n ln(var): the objective to minimise over nonlinear parameters.
 double objective(const Context& cx, const std::vector<OutputFit>& fits);
