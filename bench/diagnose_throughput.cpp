@@ -58,58 +58,6 @@ double process_cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-// The diagnosis problem as daemon/cmd_diagnose.cpp sets it up (its
-// make_problem, which lives in that command's anonymous namespace): deviation
-// inputs with the last good value held over missing samples, the residual
-// series, the recording's extra columns, the plant's channels and noise
-// models, and the monitor's verdict.
-diagnosis::Problem make_problem(const PlantModel& plant, const config::Recording& rec,
-                                const config::BoundRecording& bound, const ResidualSeries& series,
-                                const RecordVerdict& verdict) {
-  diagnosis::Problem p;
-  p.inputs = plant.inputs;
-  p.outputs = plant.outputs;
-  p.sample_time = plant.sample_time;
-  const Eigen::Index n = series.u.rows(), m = series.u.cols();
-  std::vector<double> u0(static_cast<std::size_t>(m), 0.0);
-  if (plant.operating_point) {
-    u0 = plant.operating_point->inputs;
-  } else {
-    for (Eigen::Index k = 0; k < n; ++k)
-      if (series.u.row(k).allFinite()) {
-        for (Eigen::Index i = 0; i < m; ++i) u0[static_cast<std::size_t>(i)] = series.u(k, i);
-        break;
-      }
-  }
-  p.u_abs = series.u;
-  p.du.resize(n, m);
-  for (Eigen::Index i = 0; i < m; ++i) {
-    double last = u0[static_cast<std::size_t>(i)];
-    for (Eigen::Index k = 0; k < n; ++k) {
-      if (std::isfinite(series.u(k, i))) last = series.u(k, i);
-      p.du(k, i) = last - u0[static_cast<std::size_t>(i)];
-    }
-  }
-  p.residual = series.residual;
-  p.begin = series.transient;
-  for (std::size_t c : bound.extra) p.extra_names.push_back(rec.names[c]);
-  p.extra.resize(n, static_cast<Eigen::Index>(bound.extra.size()));
-  for (std::size_t c = 0; c < bound.extra.size(); ++c)
-    p.extra.col(static_cast<Eigen::Index>(c)) = rec.data.col(static_cast<Eigen::Index>(bound.extra[c]));
-  p.nominal = channel_models(plant);
-  p.noise.resize(plant.n_outputs());
-  p.noise_variance.resize(plant.n_outputs());
-  for (std::size_t j = 0; j < plant.n_outputs() && j < plant.noise.size(); ++j)
-    if (plant.noise[j]) {
-      p.noise[j] = plant.noise[j]->tf;
-      p.noise_variance[j] = plant.noise[j]->variance;
-    }
-  p.monitor_flag = verdict.loop_mismatch;
-  p.monitor_located.resize(plant.n_outputs());
-  for (const auto& [j, i] : verdict.located) p.monitor_located[j].push_back(i);
-  return p;
-}
-
 // `mpm diagnose --quiet --plant PLANT --data DATA` up to the report: what the
 // command does before it formats the JSON (not timed: a few kB of text).
 diagnosis::Result diagnose_files(const std::string& plant_path, const std::string& data_path, std::size_t& threads) {
@@ -131,7 +79,7 @@ diagnosis::Result diagnose_files(const std::string& plant_path, const std::strin
   run_monitor_parallel(monitor, series, threads, make);
   const RecordVerdict verdict = record_verdict(monitor);
 
-  const diagnosis::Problem problem = make_problem(plant, rec, bound, series, verdict);
+  const diagnosis::Problem problem = diagnosis_problem(plant, rec, bound, series, verdict);
   return diagnosis::diagnose(problem, diagnosis::Settings{}, nullptr);
 }
 

@@ -142,55 +142,6 @@ std::string report_json(const PlantModel& plant, std::size_t samples, const Gran
 
 // --- Problem set-up ----------------------------------------------------------
 
-diagnosis::Problem make_problem(const PlantModel& plant, const config::Recording& rec,
-                                const config::BoundRecording& bound, const ResidualSeries& series,
-                                const RecordVerdict& verdict) {
-  diagnosis::Problem p;
-  p.inputs = plant.inputs;
-  p.outputs = plant.outputs;
-  p.sample_time = plant.sample_time;
-  const Eigen::Index n = series.u.rows(), m = series.u.cols();
-  // Deviation inputs as the residual generator sees them: u - u0, holding the
-  // last good value over missing samples.
-  std::vector<double> u0(static_cast<std::size_t>(m), 0.0);
-  if (plant.operating_point) {
-    u0 = plant.operating_point->inputs;
-  } else {
-    for (Eigen::Index k = 0; k < n; ++k)
-      if (series.u.row(k).allFinite()) {
-        for (Eigen::Index i = 0; i < m; ++i) u0[static_cast<std::size_t>(i)] = series.u(k, i);
-        break;
-      }
-  }
-  p.u_abs = series.u;
-  p.du.resize(n, m);
-  for (Eigen::Index i = 0; i < m; ++i) {
-    double last = u0[static_cast<std::size_t>(i)];
-    for (Eigen::Index k = 0; k < n; ++k) {
-      if (std::isfinite(series.u(k, i))) last = series.u(k, i);
-      p.du(k, i) = last - u0[static_cast<std::size_t>(i)];
-    }
-  }
-  p.residual = series.residual;
-  p.begin = series.transient;
-  for (std::size_t c : bound.extra) p.extra_names.push_back(rec.names[c]);
-  p.extra.resize(n, static_cast<Eigen::Index>(bound.extra.size()));
-  for (std::size_t c = 0; c < bound.extra.size(); ++c)
-    p.extra.col(static_cast<Eigen::Index>(c)) = rec.data.col(static_cast<Eigen::Index>(bound.extra[c]));
-  p.nominal = channel_models(plant);
-  p.noise.resize(plant.n_outputs());
-  p.noise_variance.resize(plant.n_outputs());
-  for (std::size_t j = 0; j < plant.n_outputs() && j < plant.noise.size(); ++j)
-    if (plant.noise[j]) {
-      p.noise[j] = plant.noise[j]->tf;
-      p.noise_variance[j] = plant.noise[j]->variance;
-    }
-  p.monitor_flag = verdict.loop_mismatch;
-  p.monitor_located.resize(plant.n_outputs());
-  for (const auto& [j, i] : verdict.located) p.monitor_located[j].push_back(i);
-  return p;
-}
-
 int run(int argc, char** argv) {
   try {
     const Args args(argc, argv, {"plant", "data", "json"}, {"help", "quiet", "verbose"});
@@ -220,7 +171,7 @@ int run(int argc, char** argv) {
     const RecordVerdict verdict = record_verdict(monitor);
 
     progress("fitting structured hypotheses");
-    const diagnosis::Problem problem = make_problem(plant, rec, bound, series, verdict);
+    const diagnosis::Problem problem = diagnosis_problem(plant, rec, bound, series, verdict);
     diagnosis::Settings dsettings;
     dsettings.verbose = args.flag("verbose");
     diagnosis::Result result = diagnosis::diagnose(problem, dsettings, g_quiet ? nullptr : &progress);

@@ -10,6 +10,7 @@
 #include <Eigen/Dense>
 
 #include "config/plant_loader.hpp"
+#include "core/diagnosis.hpp"
 #include "core/granger_monitor.hpp"
 #include "core/plant_model.hpp"
 
@@ -66,6 +67,14 @@ void run_monitor(GrangerMonitor& monitor, const ResidualSeries& s, OnSample&& on
     on_sample(static_cast<std::size_t>(k), monitor);
   }
 }
+
+// What `mpm diagnose` hands to the hypothesis fits (core/diagnosis.hpp):
+// deviation inputs (the last good value held over missing samples), the
+// residual series, the recording's extra columns, the plant's channels and
+// noise models, and the monitor's verdict on the record.
+diagnosis::Problem diagnosis_problem(const PlantModel& plant, const config::Recording& rec,
+                                     const config::BoundRecording& bound, const ResidualSeries& series,
+                                     const RecordVerdict& verdict);
 
 // Builds a monitor of the plant and settings at hand for some of its outputs.
 using MonitorPartFactory = std::function<GrangerMonitor(OutputRange)>;
