@@ -11,6 +11,9 @@ using givens::Rotation;
 using givens::rotate;
 using givens::rotate_inverse;
 
+// From this many regressors on, each rotation prefetches the next row.
+constexpr std::size_t kPrefetchMinRegressors = 64;
+
 SqrtRls::SqrtRls(std::size_t n_regressors, double forgetting, double regularization, bool track_inverse,
                  std::size_t wald_block)
     : p_(n_regressors),
@@ -136,10 +139,25 @@ const double* SqrtRls::coefficients_from_inverse() const noexcept {
 void SqrtRls::absorb_row(std::size_t i, double scale) noexcept {
   const std::size_t n = p_ + 1;
   const auto ii = static_cast<Eigen::Index>(i);
+  if (p_ >= kPrefetchMinRegressors && i + 1 < n) prefetch_row(i + 1);
   const Rotation rot = rotate(r_.row(ii).data(), work_.data(), i, givens::padded(n), scale);
   if (track_inverse_ && i < p_) {
     const double inv_scale = scale == sqrt_lambda_ ? inv_sqrt_lambda_ : 1.0 / scale;
     rotate_inverse(linv_.row(ii).data(), work_inv_.data(), i + 1, rot, inv_scale);
+  }
+}
+
+void SqrtRls::prefetch_row(std::size_t i) const noexcept {
+  // The part of row i of R (columns i..) and of R^-T (columns ..i) the next
+  // rotation touches, one request per cache line: large factors live in L3
+  // or memory, and each row is a short run the hardware prefetchers would
+  // only pick up after a few misses.
+  constexpr std::size_t kLine = 64 / sizeof(double);
+  const double* r = r_.row(static_cast<Eigen::Index>(i)).data();
+  for (std::size_t j = i / kLine * kLine; j < p_ + 1; j += kLine) __builtin_prefetch(r + j, 1, 1);
+  if (track_inverse_ && i < p_) {
+    const double* l = linv_.row(static_cast<Eigen::Index>(i)).data();
+    for (std::size_t j = 0; j <= i; j += kLine) __builtin_prefetch(l + j, 1, 1);
   }
 }
 

@@ -116,6 +116,7 @@ class SqrtRls {
   void absorb(std::size_t first, double scale) noexcept;
   void absorb_with_inverse(std::size_t first, double scale) noexcept;
   void absorb_row(std::size_t i, double scale) noexcept;  // rotation i only
+  void prefetch_row(std::size_t i) const noexcept;        // what rotation i will touch
   void refresh_prior() noexcept;  // the kept-alive prior row, when due
   // Tracked block covariances: after a row, S_b = growth S_b - v_b v_b^T;
   // one block a sample recomputed from L (at regressor b0).
