@@ -44,7 +44,7 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
   row_inv_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(givens::padded(a_)));
   pair_rhs_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(m_));
   coef_b_.resize(static_cast<Eigen::Index>(m_ * nb_));
-  pair_prefix_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(m_));
+  pair_prefix_.resize(static_cast<Eigen::Index>(givens::padded(a_)), static_cast<Eigen::Index>(m_));
   reset();
 }
 
@@ -209,7 +209,19 @@ const Eigen::MatrixXd& NestedRls::solve_pairs_prefix() const noexcept {
     pair_rhs_.col(ii) = top_.col(target);
     pair_rhs_.col(ii).noalias() -= top_.block(0, a + ii * nb, a, nb) * coef_b_.segment(ii * nb, nb);
   }
-  pair_prefix_.noalias() = top_inv_.leftCols(a).transpose() * pair_rhs_;
+  // pair_prefix = R_AA^-1 rhs = L^T rhs: row r of L (zeros past the
+  // diagonal, padded to whole lanes) times rhs(r, i), added to column i.
+  pair_prefix_.setZero();
+  for (Eigen::Index r = 0; r < a; ++r) {
+    const double* l = top_inv_.row(r).data();
+    const std::size_t stop = givens::padded(static_cast<std::size_t>(r) + 1);
+    for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(m_); ++i) {
+      const double t = pair_rhs_(r, i);
+      double* out = pair_prefix_.col(i).data();
+      for (std::size_t k = 0; k < stop; k += givens::kLanes)
+        givens::store(out + k, givens::load(out + k) + t * givens::load(l + k));
+    }
+  }
   return pair_prefix_;
 }
 

@@ -79,7 +79,8 @@ class NestedRls {
   // out). Real-time safe.
   void solve_pair_prefix(std::size_t i, Eigen::Ref<Eigen::VectorXd> out) const noexcept;
   // The same for every pairwise model at once (one pass over R_AA serves
-  // all): column i holds the A coefficients of [A, B_i]. The result lives
+  // all): column i holds the A coefficients of [A, B_i] in its first
+  // prefix() rows (then zero padding). The result lives
   // until the next call. Real-time safe.
   const Eigen::MatrixXd& solve_pairs_prefix() const noexcept;
   // All coefficients of the full model (n_regressors() values). Real-time safe.
@@ -112,7 +113,7 @@ class NestedRls {
   Eigen::VectorXd row_;           // staged row, cols values
   mutable Eigen::VectorXd coef_b_;  // scratch: B coefficients (m nb)
   mutable Eigen::MatrixXd pair_rhs_;     // a x m: R_Ay - R_AB_i beta_B_i
-  mutable Eigen::MatrixXd pair_prefix_;  // a x m: solve_pairs_prefix's result
+  mutable Eigen::MatrixXd pair_prefix_;  // padded(a) x m: solve_pairs_prefix's result
 
   // Rotates row_ through the trapezoid rows [first, a) with `scale`.
   void absorb_top(std::size_t first, double scale) noexcept;

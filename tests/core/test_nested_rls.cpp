@@ -97,8 +97,12 @@ void expect_equal_to_separate_fits(std::size_t m, double lambda, int samples, do
     Eigen::VectorXd got(a), want(a + nb);
     nested.solve_pair_prefix(i, got);
     separate.pair[i].solve_prefix(a + nb, want);
-    for (std::size_t c = 0; c < a; ++c)
-      EXPECT_NEAR(got[static_cast<Eigen::Index>(c)], want[static_cast<Eigen::Index>(c)], 1e3 * tol) << "block " << i;
+    const Eigen::MatrixXd& all = nested.solve_pairs_prefix();  // every pairwise model at once
+    for (std::size_t c = 0; c < a; ++c) {
+      const auto cc = static_cast<Eigen::Index>(c);
+      EXPECT_NEAR(got[cc], want[cc], 1e3 * tol) << "block " << i;
+      EXPECT_NEAR(all(cc, static_cast<Eigen::Index>(i)), want[cc], 1e3 * tol) << "block " << i << " (all at once)";
+    }
   }
   Eigen::VectorXd got(p), want(p);
   nested.solve_full(got);
