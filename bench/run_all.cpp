@@ -103,7 +103,7 @@ void memory_figures(Plan& plan) {
 void update_figures(Plan& plan, const PeakRate& peak, std::int64_t& allocations, std::size_t& updates) {
   const std::vector<Size> sizes = plan.quick()
       ? std::vector<Size>{{2, 300, 3}, {4, 50, 3}, {20, 2, 1}, {50, 1, 1}}
-      : std::vector<Size>{{2, 3000, 7}, {4, 500, 7}, {20, 4, 5}, {50, 1, 3}};
+      : std::vector<Size>{{2, 3000, 7}, {4, 500, 7}, {20, 4, 5}, {50, 2, 5}};
   const MonitorSettings s = paper_settings();
   for (const Size& size : sizes) {
     plan.say("GrangerMonitor::update at " + tag(size.n));
