@@ -221,7 +221,7 @@ void diagnose_figure(Plan& plan) {
   std::snprintf(text, sizeof text,
                 "%zu-sample closed-loop recording of scenario %s (seed 1; built-in wood-berry.yaml) written to "
                 "temporary files, then diagnosed as `mpm diagnose --quiet` does, by the same library calls in this "
-                "process (not the mpm binary; its problem set-up copied from daemon/cmd_diagnose.cpp): load and "
+                "process (not the mpm binary; the same daemon/offline functions as the command): load and "
                 "parse plant YAML and CSV, bind, residuals, Granger monitor (forgetting 1) over %zu threads, "
                 "structured hypotheses (core/diagnosis.hpp); JSON report not timed; wall-clock, median of %zu "
                 "runs (fastest %.0f samples/s; %.2f s wall, %.2f s process CPU)",
