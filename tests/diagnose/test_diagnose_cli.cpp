@@ -1,31 +1,23 @@
 // `mpm diagnose` on simulated recordings with known truth: the report keeps
 // the contract of formats.md section 3 and names the planted mismatch.
 #include <cstdlib>
-#include <fstream>
 #include <regex>
 #include <set>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "support/cli.hpp"
+
 namespace {
 
-const std::string kMpm = std::string(MPM_BINARY_DIR) + "/daemon/mpm";
 const std::string kWoodBerry = std::string(MPM_SOURCE_DIR) + "/config/wood-berry.yaml";
 
-std::string tmp_path(const std::string& name) {
-  return (::testing::TempDir().empty() ? std::string("/tmp/") : ::testing::TempDir()) + "mpm_diag_" + name;
-}
+using mpm::test::kMpm;
+using mpm::test::read_file;
 
-int run(const std::string& cmd) { return std::system((cmd + " >/dev/null 2>&1").c_str()); }
-
-std::string read(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+std::string tmp_path(const std::string& name) { return mpm::test::tmp_path("mpm_diag_", name); }
+int run(const std::string& cmd) { return mpm::test::run_quietly(cmd); }
 
 // Simulates a scenario and diagnoses it; returns the report text.
 std::string diagnose_scenario(const std::string& scenario, int seed, int samples = 3000) {
@@ -34,7 +26,7 @@ std::string diagnose_scenario(const std::string& scenario, int seed, int samples
                 std::to_string(seed) + " --out " + csv),
             0);
   EXPECT_EQ(run(kMpm + " diagnose --quiet --plant " + kWoodBerry + " --data " + csv + " --json " + out), 0);
-  return read(out);
+  return read_file(out);
 }
 
 std::set<std::string> physics_words(const std::string& report) {
@@ -97,7 +89,7 @@ TEST(DiagnoseCli, ErrorsNameTheFileAndUseExitCodes) {
   EXPECT_EQ(WEXITSTATUS(run(kMpm + " diagnose --plant " + kWoodBerry + " --data /nonexistent.csv")), 1);
   const std::string err = tmp_path("err.txt");
   std::system((kMpm + " diagnose --plant " + kWoodBerry + " --data /nonexistent.csv 2>" + err).c_str());
-  EXPECT_NE(read(err).find("/nonexistent.csv"), std::string::npos);
+  EXPECT_NE(read_file(err).find("/nonexistent.csv"), std::string::npos);
 }
 
 }  // namespace

@@ -1,29 +1,21 @@
 // `mpm monitor` end to end: the replay split over threads (each a part of
 // the outputs) gives the report one thread gives, byte for byte.
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "support/cli.hpp"
+
 namespace {
 
-const std::string kMpm = std::string(MPM_BINARY_DIR) + "/daemon/mpm";
 const std::string kQuadTank = std::string(MPM_SOURCE_DIR) + "/config/quad-tank-4x4.yaml";
 
-std::string tmp_path(const std::string& name) {
-  return (::testing::TempDir().empty() ? std::string("/tmp/") : ::testing::TempDir()) + "mpm_monitor_" + name;
-}
+using mpm::test::kMpm;
+using mpm::test::read_file;
 
-int run(const std::string& cmd) { return std::system((cmd + " >/dev/null 2>&1").c_str()); }
-
-std::string read(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+std::string tmp_path(const std::string& name) { return mpm::test::tmp_path("mpm_monitor_", name); }
+int run(const std::string& cmd) { return mpm::test::run_quietly(cmd); }
 
 TEST(MonitorCli, ThreadsDoNotChangeTheReport) {
   const std::string csv = tmp_path("g23.csv");
@@ -36,7 +28,7 @@ TEST(MonitorCli, ThreadsDoNotChangeTheReport) {
                            " --json --threads " + std::to_string(threads[t]) + " > " + out + " 2>/dev/null")
                               .c_str()),
               0);
-    reports[t] = read(out);
+    reports[t] = read_file(out);
   }
   ASSERT_GT(reports[0].size(), 100u);
   EXPECT_NE(reports[0].find("\"alarm\": true"), std::string::npos);  // the planted G23 is raised: a real run
