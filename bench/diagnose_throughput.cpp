@@ -68,15 +68,8 @@ diagnosis::Result diagnose_files(const std::string& plant_path, const std::strin
 
   MonitorSettings settings;
   settings.forgetting = 1.0;
-  const auto noise = noise_ar(plant, settings.ar_order);
-  const auto reference = reference_variances(plant);
-  const auto channels = channel_models(plant);
-  const auto make = [&](OutputRange outputs) {
-    return GrangerMonitor(plant.n_inputs(), plant.n_outputs(), settings, noise, reference, channels, outputs);
-  };
-  GrangerMonitor monitor = make(OutputRange{});
   threads = replay_threads(plant.n_outputs());
-  run_monitor_parallel(monitor, series, threads, make);
+  const GrangerMonitor monitor = monitor_record(plant, series, settings, threads);
   const RecordVerdict verdict = record_verdict(monitor);
 
   const diagnosis::Problem problem = diagnosis_problem(plant, rec, bound, series, verdict);

@@ -160,14 +160,7 @@ int run(int argc, char** argv) {
 
     MonitorSettings settings;
     settings.forgetting = 1.0;
-    const auto noise = noise_ar(plant, settings.ar_order);
-    const auto reference = reference_variances(plant);
-    const auto channels = channel_models(plant);
-    const auto make = [&](OutputRange outputs) {
-      return GrangerMonitor(plant.n_inputs(), plant.n_outputs(), settings, noise, reference, channels, outputs);
-    };
-    GrangerMonitor monitor = make(OutputRange{});
-    run_monitor_parallel(monitor, series, replay_threads(plant.n_outputs()), make);
+    const GrangerMonitor monitor = monitor_record(plant, series, settings, replay_threads(plant.n_outputs()));
     const RecordVerdict verdict = record_verdict(monitor);
 
     progress("fitting structured hypotheses");

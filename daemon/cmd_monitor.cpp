@@ -112,19 +112,12 @@ int run(int argc, char** argv) {
     const config::BoundRecording bound = config::bind(plant, rec);
     const ResidualSeries series = compute_residuals(plant, rec, bound);
 
-    const auto noise = noise_ar(plant, settings.ar_order);
-    const auto reference = reference_variances(plant);
-    const auto channels =
-        args.flag("plain-lags") ? std::vector<std::optional<DiscreteTf>>{} : channel_models(plant);
-    const auto make = [&](OutputRange outputs) {
-      return GrangerMonitor(plant.n_inputs(), plant.n_outputs(), settings, noise, reference, channels, outputs);
-    };
     const std::size_t threads =
         requested_threads > 0 ? static_cast<std::size_t>(requested_threads) : replay_threads(plant.n_outputs());
-    GrangerMonitor monitor = make(OutputRange{});
     std::vector<ChannelTrace> trace(plant.n_inputs() * plant.n_outputs());
     // On each part's thread: only its outputs, so the parts write disjoint traces.
-    run_monitor_parallel(monitor, series, threads, make, [&](std::size_t k, const GrangerMonitor& m) {
+    const GrangerMonitor monitor =
+        monitor_record(plant, series, settings, threads, args.flag("plain-lags"), [&](std::size_t k, const GrangerMonitor& m) {
       for (std::size_t j = m.first_modelled_output(); j < m.end_modelled_output(); ++j)
         for (std::size_t i = 0; i < m.n_inputs(); ++i) {
           ChannelTrace& t = trace[j * m.n_inputs() + i];

@@ -104,6 +104,14 @@ std::vector<double> reference_variances(const PlantModel& plant) {
   return out;
 }
 
+MonitorPartFactory monitor_factory(const PlantModel& plant, const MonitorSettings& settings, bool plain_lags) {
+  return [m = plant.n_inputs(), n = plant.n_outputs(), settings, noise = noise_ar(plant, settings.ar_order),
+          reference = reference_variances(plant),
+          channels = plain_lags ? std::vector<std::optional<DiscreteTf>>{} : channel_models(plant)](OutputRange outputs) {
+    return GrangerMonitor(m, n, settings, noise, reference, channels, outputs);
+  };
+}
+
 std::size_t replay_threads(std::size_t outputs) {
   const std::size_t cores = std::max<std::size_t>(1, std::thread::hardware_concurrency());
   return std::max<std::size_t>(1, std::min(cores, outputs));
@@ -149,6 +157,14 @@ void run_monitor_parallel(GrangerMonitor& monitor, const ResidualSeries& s, std:
   const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> d = s.residual;
   run_monitor_parallel(monitor, u.data(), d.data(), s.transient, static_cast<std::size_t>(s.u.rows()), threads,
                        make_part, on_sample);
+}
+
+GrangerMonitor monitor_record(const PlantModel& plant, const ResidualSeries& s, const MonitorSettings& settings,
+                              std::size_t threads, bool plain_lags, const PartSampleCallback& on_sample) {
+  const MonitorPartFactory make = monitor_factory(plant, settings, plain_lags);
+  GrangerMonitor monitor = make(OutputRange{});
+  run_monitor_parallel(monitor, s, threads, make, on_sample);
+  return monitor;
 }
 
 diagnosis::Problem diagnosis_problem(const PlantModel& plant, const config::Recording& rec,

@@ -83,6 +83,10 @@ using MonitorPartFactory = std::function<GrangerMonitor(OutputRange)>;
 // end_modelled_output()) are meaningful in it.
 using PartSampleCallback = std::function<void(std::size_t, const GrangerMonitor&)>;
 
+// Monitors of `plant` with `settings`: its noise models (for gamma) and
+// reference variances, and model-filtered regressors unless `plain_lags`.
+MonitorPartFactory monitor_factory(const PlantModel& plant, const MonitorSettings& settings, bool plain_lags = false);
+
 // Threads worth using for a monitor of `outputs` outputs on this machine:
 // one per core, at most one per output, at least one.
 std::size_t replay_threads(std::size_t outputs);
@@ -99,5 +103,9 @@ void run_monitor_parallel(GrangerMonitor& monitor, const double* u, const double
 // The same over a residual series (after its transient).
 void run_monitor_parallel(GrangerMonitor& monitor, const ResidualSeries& s, std::size_t threads,
                           const MonitorPartFactory& make_part, const PartSampleCallback& on_sample = {});
+// The whole plant's monitor after the series (after its transient),
+// replayed over `threads` threads by run_monitor_parallel.
+GrangerMonitor monitor_record(const PlantModel& plant, const ResidualSeries& s, const MonitorSettings& settings,
+                              std::size_t threads, bool plain_lags = false, const PartSampleCallback& on_sample = {});
 
 }  // namespace mpm
