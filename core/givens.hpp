@@ -31,6 +31,19 @@ inline Lanes load(const double* p) noexcept {
 }
 inline void store(double* p, Lanes v) noexcept { __builtin_memcpy(p, &v, sizeof v); }
 typedef long long LaneMask __attribute__((vector_size(kLanes * sizeof(long long))));
+inline double sum(Lanes v) noexcept {
+  double s = 0.0;
+  for (std::size_t k = 0; k < kLanes; ++k) s += v[k];
+  return s;
+}
+// The sums of four vectors at once, {sum(a), sum(b), sum(c), sum(d)}: four
+// shuffles and three additions instead of four separate reductions.
+static_assert(kLanes == 4, "sum4 transposes four vectors of four lanes");
+inline Lanes sum4(Lanes a, Lanes b, Lanes c, Lanes d) noexcept {
+  const Lanes ab = __builtin_shuffle(a, b, LaneMask{0, 4, 2, 6}) + __builtin_shuffle(a, b, LaneMask{1, 5, 3, 7});
+  const Lanes cd = __builtin_shuffle(c, d, LaneMask{0, 4, 2, 6}) + __builtin_shuffle(c, d, LaneMask{1, 5, 3, 7});
+  return __builtin_shuffle(ab, cd, LaneMask{0, 1, 4, 5}) + __builtin_shuffle(ab, cd, LaneMask{2, 3, 6, 7});
+}
 constexpr LaneMask kLaneIndex = {0, 1, 2, 3};
 
 // Rotates the pivot row a, scaled by `scale` first, against row b so that

@@ -105,6 +105,8 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   pair_coef_.resize(static_cast<Eigen::Index>(1 + na_));
   const auto lower = static_cast<Eigen::Index>(n_inputs * nb_ + 1);
   scratch_.resize(lower, lower);
+  rss_ratios_ = Eigen::ArrayXd::Ones(static_cast<Eigen::Index>(1 + 2 * n_inputs));
+  log_ratios_ = Eigen::ArrayXd::Zero(static_cast<Eigen::Index>(1 + 2 * n_inputs));
 
   n_inverse_ar_.resize(n_outputs);
   for (std::size_t j = 0; j < n_inverse_ar.size(); ++j) {
@@ -270,15 +272,27 @@ void GrangerMonitor::update_statistics() noexcept {
     loop.sigma1 = rss_ar / sum_w_;
     loop.sigma_full = rss_full / sum_w_;
     loop.residual_variance = reg.rss_head(1) / sum_w_;
-    loop.lr_joint = scale_full * std::log(rss_ar / rss_full);
+    // Every F of this output is the log of an RSS ratio: the ratios first,
+    // then one vectorised log for all of them (a scalar log each costs as
+    // much as a rotation).
+    const auto m = static_cast<Eigen::Index>(n_inputs_);
+    rss_ratios_[0] = rss_ar / rss_full;
+    for (std::size_t i = 0; i < n_inputs_; ++i) {
+      const auto ii = static_cast<Eigen::Index>(i);
+      rss_ratios_[1 + ii] = reg.rss_without_block(i, scratch_) / rss_full;
+      rss_ratios_[1 + m + ii] = reg.rss_pair_prefix_only(i) / reg.rss_pair(i);
+    }
+    log_ratios_ = rss_ratios_.log();
+    loop.lr_joint = scale_full * log_ratios_[0];
     // The AR parts of every pairwise model, for gamma, in one solve.
     const Eigen::MatrixXd* pair_prefix = n_inverse_ar_[j] ? &reg.solve_pairs_prefix() : nullptr;
     bool any_channel = false;
     for (std::size_t i = 0; i < n_inputs_; ++i) {
+      const auto ii = static_cast<Eigen::Index>(i);
       ChannelStats& c = channels_[j * n_inputs_ + i];
-      c.f_conditional = std::log(reg.rss_without_block(i, scratch_) / rss_full);
+      c.f_conditional = log_ratios_[1 + ii];
       c.lr_conditional = scale_full * c.f_conditional;
-      c.f_pairwise = std::log(reg.rss_pair_prefix_only(i) / reg.rss_pair(i));
+      c.f_pairwise = log_ratios_[1 + m + ii];
       c.lr_pairwise = scale_pair * c.f_pairwise;
 
       if (n_inverse_ar_[j]) {

@@ -232,6 +232,10 @@ class GrangerMonitor {
   std::vector<NestedRls> regressions_;
   mutable Eigen::VectorXd pair_coef_;  // scratch: [1, AR] coefficients of a pairwise model
   SqrtRls::Matrix scratch_;        // scratch for conditional RSS
+  // Scratch: one output's RSS ratios [joint, conditional (m), pairwise (m)]
+  // and their logarithms, taken in one vectorised call.
+  Eigen::ArrayXd rss_ratios_;
+  Eigen::ArrayXd log_ratios_;
 
   std::vector<std::optional<Eigen::VectorXd>> n_inverse_ar_;
   std::vector<ChannelStats> channels_;

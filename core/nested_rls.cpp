@@ -36,7 +36,9 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
   if (!(regularization > 0.0)) throw std::invalid_argument("NestedRls: regularization must be > 0");
   prior_period_ = givens::prior_period(a_, forgetting);
   prior_weight_ = givens::prior_weight(a_, prior_period_, forgetting, delta_);
-  top_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(givens::padded(cols_)));
+  // One spare block of lanes past the padded width (always zero): whole-lane
+  // reads of a block of B columns may run past the last one.
+  top_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(givens::padded(cols_) + givens::kLanes));
   lower_ = SqrtRls(m_ * nb_, forgetting, regularization, track_inverse, track_inverse ? nb_ : 0);
   pairs_.assign(m_ - 1, SqrtRls(nb_, forgetting, regularization));
   row_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(givens::padded(cols_)));
@@ -44,6 +46,7 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
   row_inv_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(givens::padded(a_)));
   pair_rhs_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(m_));
   coef_b_.resize(static_cast<Eigen::Index>(m_ * nb_));
+  pair_beta_b_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(givens::padded(nb_)), static_cast<Eigen::Index>(m_));
   pair_prefix_.resize(static_cast<Eigen::Index>(givens::padded(a_)), static_cast<Eigen::Index>(m_));
   reset();
 }
@@ -67,7 +70,8 @@ void NestedRls::absorb_top(std::size_t first, double scale) noexcept {
   for (std::size_t i = first; i < a_; ++i) rotate_top_row(i, scale);
 }
 
-void NestedRls::rotate_top_row(std::size_t i, double scale) noexcept {
+// Inlined into the lockstep loop, as SqrtRls::absorb_row.
+[[gnu::always_inline]] inline void NestedRls::rotate_top_row(std::size_t i, double scale) noexcept {
   const auto ii = static_cast<Eigen::Index>(i);
   const givens::Rotation rot = givens::rotate(top_.row(ii).data(), row_.data(), i, givens::padded(cols_), scale);
   const double inv_scale = scale == sqrt_lambda_ ? inv_sqrt_lambda_ : 1.0 / scale;
@@ -194,32 +198,66 @@ void NestedRls::solve_top(std::size_t b0, std::size_t count, const double* beta_
 }
 
 const Eigen::MatrixXd& NestedRls::solve_pairs_prefix() const noexcept {
-  // Right-hand sides R_Ay - R_AB_i beta_B_i of every pairwise model, one
-  // column each, then one back substitution for all of them.
-  const auto target = static_cast<Eigen::Index>(cols_ - 1);
+  using givens::Lanes;
+  using givens::load;
+  constexpr std::size_t kLanes = givens::kLanes;
+  const std::size_t target = cols_ - 1;
+  const std::size_t nb_padded = givens::padded(nb_);
+  // beta_B_i of every pairwise model, each zero-padded to whole lanes.
   for (std::size_t i = 0; i < m_; ++i) {
-    auto beta_b = coef_b_.segment(static_cast<Eigen::Index>(i * nb_), static_cast<Eigen::Index>(nb_));
-    if (i == 0) lower_.solve_prefix(nb_, beta_b);
-    else pairs_[i - 1].solve_prefix(nb_, beta_b);
+    double* beta_b = pair_beta_b_.col(static_cast<Eigen::Index>(i)).data();
+    if (i == 0) lower_.solve_prefix_padded(nb_, beta_b);
+    else pairs_[i - 1].solve_prefix_padded(nb_, beta_b);
   }
-  const auto a = static_cast<Eigen::Index>(a_);
-  const auto nb = static_cast<Eigen::Index>(nb_);
+  // Right-hand sides R_Ay - R_AB_i beta_B_i, one column each: a dot product
+  // of whole lanes per row (the lanes past B_i meet beta's zero padding;
+  // top_ has a spare block of lanes so the last block stays inside the row),
+  // four rows' reductions done together.
+  const double* top = top_.data();
+  const auto top_ld = static_cast<std::size_t>(top_.cols());
+  const double* betas = pair_beta_b_.data();
+  double* rhs = pair_rhs_.data();
+  const auto dot = [&](std::size_t r, std::size_t i) {
+    const double* bi = top + r * top_ld + a_ + i * nb_;
+    const double* beta = betas + i * nb_padded;
+    Lanes acc = {};
+    for (std::size_t k = 0; k < nb_padded; k += kLanes) acc += load(bi + k) * load(beta + k);
+    return acc;
+  };
   for (std::size_t i = 0; i < m_; ++i) {
-    const auto ii = static_cast<Eigen::Index>(i);
-    pair_rhs_.col(ii) = top_.col(target);
-    pair_rhs_.col(ii).noalias() -= top_.block(0, a + ii * nb, a, nb) * coef_b_.segment(ii * nb, nb);
+    double* out = rhs + i * a_;
+    std::size_t r = 0;
+    for (; r + 4 <= a_; r += 4) {
+      const Lanes y = {top[r * top_ld + target], top[(r + 1) * top_ld + target], top[(r + 2) * top_ld + target],
+                       top[(r + 3) * top_ld + target]};
+      givens::store(out + r, y - givens::sum4(dot(r, i), dot(r + 1, i), dot(r + 2, i), dot(r + 3, i)));
+    }
+    for (; r < a_; ++r) out[r] = top[r * top_ld + target] - givens::sum(dot(r, i));
   }
-  // pair_prefix = R_AA^-1 rhs = L^T rhs: row r of L (zeros past the
-  // diagonal, padded to whole lanes) times rhs(r, i), added to column i.
-  pair_prefix_.setZero();
-  for (Eigen::Index r = 0; r < a; ++r) {
-    const double* l = top_inv_.row(r).data();
-    const std::size_t stop = givens::padded(static_cast<std::size_t>(r) + 1);
-    for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(m_); ++i) {
-      const double t = pair_rhs_(r, i);
-      double* out = pair_prefix_.col(i).data();
-      for (std::size_t k = 0; k < stop; k += givens::kLanes)
-        givens::store(out + k, givens::load(out + k) + t * givens::load(l + k));
+  // pair_prefix = R_AA^-1 rhs = L^T rhs, L = R_AA^-T lower triangular: each
+  // block of lanes of the result sums rows r >= its first column (rows above
+  // are zero there), accumulated in registers, two inputs sharing each load
+  // of L.
+  const std::size_t a_padded = givens::padded(a_);
+  const double* inv = top_inv_.data();
+  const auto inv_ld = static_cast<std::size_t>(top_inv_.cols());
+  double* prefix = pair_prefix_.data();
+  for (std::size_t i = 0; i < m_; i += 2) {
+    const bool two = i + 1 < m_;
+    const double* rhs0 = rhs + i * a_;
+    const double* rhs1 = two ? rhs0 + a_ : rhs0;
+    double* out0 = prefix + i * a_padded;
+    for (std::size_t k = 0; k < a_padded; k += kLanes) {
+      Lanes acc0 = {};
+      Lanes acc1 = {};
+      const double* l = inv + k * inv_ld + k;
+      for (std::size_t r = k; r < a_; ++r, l += inv_ld) {
+        const Lanes lr = load(l);
+        acc0 += rhs0[r] * lr;
+        acc1 += rhs1[r] * lr;
+      }
+      givens::store(out0 + k, acc0);
+      if (two) givens::store(out0 + a_padded + k, acc1);
     }
   }
   return pair_prefix_;

@@ -102,7 +102,7 @@ class NestedRls {
   int since_prior_ = 0;
   double prior_weight_ = 0.0;
   std::size_t next_prior_row_ = 0;
-  Matrix top_;                    // a x cols: the A rows [R_AA R_AB R_Ay]
+  Matrix top_;                    // a x (padded cols + lanes): the A rows [R_AA R_AB R_Ay]
   Matrix top_inv_;                // a x a lower triangular R_AA^-T, carried
                                   // through the same rotations (sqrt_rls.hpp):
                                   // the pairwise coefficients without a
@@ -112,6 +112,7 @@ class NestedRls {
   std::vector<SqrtRls> pairs_;    // [B_i | y] given A, i = 2..m
   Eigen::VectorXd row_;           // staged row, cols values
   mutable Eigen::VectorXd coef_b_;  // scratch: B coefficients (m nb)
+  mutable Eigen::MatrixXd pair_beta_b_;  // padded(nb) x m: beta_B_i, zero padded
   mutable Eigen::MatrixXd pair_rhs_;     // a x m: R_Ay - R_AB_i beta_B_i
   mutable Eigen::MatrixXd pair_prefix_;  // padded(a) x m: solve_pairs_prefix's result
 

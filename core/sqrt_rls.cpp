@@ -34,6 +34,7 @@ SqrtRls::SqrtRls(std::size_t n_regressors, double forgetting, double regularizat
   const auto width = static_cast<Eigen::Index>(givens::padded(p_ + 1));
   r_.resize(n, width);
   work_ = Eigen::VectorXd::Zero(width);
+  rss_tail_ = Eigen::VectorXd::Zero(n);
   if (track_inverse_) {
     const auto inv_width = static_cast<Eigen::Index>(givens::padded(p_));
     linv_.resize(n - 1, inv_width);
@@ -71,6 +72,7 @@ void SqrtRls::absorb(std::size_t first, double scale) noexcept {
   const std::size_t n = p_ + 1;
   const std::size_t width = givens::padded(n);
   double* w = work_.data();
+  ++changes_;
   for (std::size_t i = first; i < n; ++i) rotate(r_.row(static_cast<Eigen::Index>(i)).data(), w, i, width, scale);
 }
 
@@ -136,7 +138,9 @@ const double* SqrtRls::coefficients_from_inverse() const noexcept {
   return beta;
 }
 
-void SqrtRls::absorb_row(std::size_t i, double scale) noexcept {
+// Inlined into the lockstep loop: as a call, its prologue (stack realignment
+// for vector spills, saved registers) costs a quarter of a short rotation.
+[[gnu::always_inline]] inline void SqrtRls::absorb_row(std::size_t i, double scale) noexcept {
   const std::size_t n = p_ + 1;
   const auto ii = static_cast<Eigen::Index>(i);
   if (p_ >= kPrefetchMinRegressors && i + 1 < n) prefetch_row(i + 1);
@@ -210,13 +214,19 @@ void SqrtRls::refresh_prior() noexcept {
 }
 
 double SqrtRls::rss_prefix(std::size_t k) const noexcept {
-  double s = 0.0;
-  const auto last = static_cast<Eigen::Index>(p_);
-  for (std::size_t i = k; i <= p_; ++i) {
-    const double v = r_(static_cast<Eigen::Index>(i), last);
-    s += v * v;
+  if (rss_stamp_ != changes_) {
+    // Suffix sums of the squared target column: RSS of the first k
+    // regressors is what rows k..p leave of y.
+    const auto last = static_cast<Eigen::Index>(p_);
+    double s = 0.0;
+    for (std::size_t i = p_ + 1; i-- > 0;) {
+      const double v = r_(static_cast<Eigen::Index>(i), last);
+      s += v * v;
+      rss_tail_[static_cast<Eigen::Index>(i)] = s;
+    }
+    rss_stamp_ = changes_;
   }
-  return s;
+  return rss_tail_[static_cast<Eigen::Index>(k)];
 }
 
 double SqrtRls::rss_without(std::size_t first, std::size_t count, Matrix& scratch) const noexcept {
@@ -358,6 +368,24 @@ void SqrtRls::solve_prefix(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const
     const double b = beta[i] * (1.0 / r_(ii, ii));
     beta[i] = b;
     for (std::size_t r = 0; r < i; ++r) beta[r] -= r_(static_cast<Eigen::Index>(r), ii) * b;
+  }
+}
+
+void SqrtRls::solve_prefix_padded(std::size_t k, double* __restrict beta) const noexcept {
+  // Column by column as solve_prefix (one product and one update on the
+  // dependency chain per coefficient), with plain pointers: no alias checks
+  // or strided-gather vector code, which cost more than they save on the
+  // short prefixes the monitor solves every sample.
+  const std::size_t stop = givens::padded(k);
+  std::fill(beta + k, beta + stop, 0.0);
+  const double* __restrict r = r_.data();
+  const auto ld = static_cast<std::size_t>(r_.cols());
+  for (std::size_t i = 0; i < k; ++i) beta[i] = r[i * ld + p_];
+  for (std::size_t i = k; i-- > 0;) {
+    const double* col = r + i;
+    const double b = beta[i] * (1.0 / col[i * ld]);
+    beta[i] = b;
+    for (std::size_t row = 0; row < i; ++row) beta[row] -= col[row * ld] * b;
   }
 }
 

@@ -73,8 +73,13 @@ class SqrtRls {
   std::size_t n_regressors() const noexcept { return p_; }
   // Weighted residual sum of squares of the model of the first k regressors
   // (k = 0: sum of squares of y; k = n_regressors(): the full model).
+  // Real-time safe; the first call after a change sums the target column
+  // once for every k (the monitor asks for several k per sample).
   double rss_prefix(std::size_t k) const noexcept;
-  double rss() const noexcept { return rss_prefix(p_); }
+  double rss() const noexcept {
+    const double v = r_(static_cast<Eigen::Index>(p_), static_cast<Eigen::Index>(p_));
+    return v * v;
+  }
   // Weighted RSS of the model that leaves out regressors [first, first+count).
   // `scratch` must be at least (p+1) x (p+1); it is overwritten. Real-time safe.
   double rss_without(std::size_t first, std::size_t count, Matrix& scratch) const noexcept;
@@ -85,6 +90,9 @@ class SqrtRls {
   // Coefficients of the model of the first k regressors (back substitution).
   // out.size() >= k; writes out[0..k). Real-time safe.
   void solve_prefix(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const noexcept;
+  // The same into `out` with room for padded(k) values (givens.hpp), the
+  // ones past k left zero: the form the monitor's per-sample solves use.
+  void solve_prefix_padded(std::size_t k, double* out) const noexcept;
   // The factor, (p+1) x (p+1) upper triangular; last column = target.
   Eigen::Ref<const Matrix> factor() const noexcept { return r_.leftCols(static_cast<Eigen::Index>(p_ + 1)); }
   // The tracked R^-T of the regressor part, p x p lower triangular (empty
@@ -134,6 +142,8 @@ class SqrtRls {
   std::uint64_t changes_ = 0;      // bumped by every absorbed row
   mutable std::uint64_t coef_stamp_ = ~std::uint64_t{0};
   mutable Eigen::VectorXd coef_;   // L^T z when coef_stamp_ == changes_
+  mutable std::uint64_t rss_stamp_ = ~std::uint64_t{0};
+  mutable Eigen::VectorXd rss_tail_;  // rss_prefix(k) for k = 0..p when rss_stamp_ == changes_
 };
 
 }  // namespace mpm
