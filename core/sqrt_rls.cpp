@@ -35,6 +35,11 @@ SqrtRls::SqrtRls(std::size_t n_regressors, double forgetting, double regularizat
   r_.resize(n, width);
   work_ = Eigen::VectorXd::Zero(width);
   rss_tail_ = Eigen::VectorXd::Zero(n);
+  if (p_ >= kPrefetchMinRegressors) {  // update_in_one_pass's rows
+    prior_work_ = Eigen::VectorXd::Zero(width);
+    rss_target_ = Eigen::VectorXd::Zero(n);
+    if (track_inverse) prior_work_inv_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(givens::padded(p_)));
+  }
   if (track_inverse_) {
     const auto inv_width = static_cast<Eigen::Index>(givens::padded(p_));
     linv_.resize(n - 1, inv_width);
@@ -83,6 +88,10 @@ void SqrtRls::absorb_with_inverse(std::size_t first, double scale) noexcept {
 }
 
 void SqrtRls::downdate_block_covariances(double growth) noexcept {
+  downdate_block_covariances(growth, work_inv_.data());
+}
+
+void SqrtRls::downdate_block_covariances(double growth, const double* v) noexcept {
   ++changes_;
   if (wald_block_ == 0) return;
   // Rotations preserve the Gram matrix of the columns of [L / sqrt(lambda);
@@ -90,7 +99,6 @@ void SqrtRls::downdate_block_covariances(double growth) noexcept {
   //   P / lambda = P' + v v^T,  P = (R^T R)^-1 = L^T L.
   // So each diagonal block of P' is the old one, grown by 1 / lambda, less
   // v_b v_b^T: O(p nb) instead of O(p^2 nb) from L. Lower triangles only.
-  const double* v = work_inv_.data();
   const std::size_t nb = wald_block_;
   for (std::size_t b0 = 0; b0 < p_; b0 += nb) {
     for (std::size_t r = 0; r < nb; ++r) {
@@ -158,10 +166,10 @@ void SqrtRls::prefetch_row(std::size_t i) const noexcept {
   // only pick up after a few misses.
   constexpr std::size_t kLine = 64 / sizeof(double);
   const double* r = r_.row(static_cast<Eigen::Index>(i)).data();
-  for (std::size_t j = i / kLine * kLine; j < p_ + 1; j += kLine) __builtin_prefetch(r + j, 1, 1);
+  for (std::size_t j = i / kLine * kLine; j < p_ + 1; j += kLine) __builtin_prefetch(r + j, 0, 2);
   if (track_inverse_ && i < p_) {
     const double* l = linv_.row(static_cast<Eigen::Index>(i)).data();
-    for (std::size_t j = 0; j <= i; j += kLine) __builtin_prefetch(l + j, 1, 1);
+    for (std::size_t j = 0; j <= i; j += kLine) __builtin_prefetch(l + j, 0, 2);
   }
 }
 
@@ -179,6 +187,7 @@ void SqrtRls::add_row(const double* x, double y) noexcept {
 }
 
 void SqrtRls::update_staged(SqrtRls* const* models, std::size_t count) noexcept {
+  if (count == 1 && models[0]->p_ >= kPrefetchMinRegressors) return models[0]->update_in_one_pass();
   // Rotation i of every model, then rotation i + 1: the models' chains of
   // dependent square roots and divisions overlap in the pipeline.
   std::size_t rows = 0;
@@ -199,6 +208,73 @@ void SqrtRls::update_staged(SqrtRls* const* models, std::size_t count) noexcept 
     }
     s.refresh_prior();
   }
+}
+
+void SqrtRls::update_in_one_pass() noexcept {
+  // A large factor lives in L3 or memory, so its cost is the passes over it.
+  // Everything a sample does to it is done row by row in one pass:
+  //  * the sample's rotation of row i (forgetting folded in), then, when the
+  //    kept-alive prior is due, the prior row's rotation of the same row:
+  //    the sample's row has already left row i, and the prior's row reaches
+  //    it after rows [k, i) took both rotations, exactly as in two passes;
+  //  * once row i is final, its share of beta = L^T z (z the target column)
+  //    and its target entry for the RSS suffix sums, while the row is in
+  //    cache, instead of a pass over L and a strided walk of R afterwards.
+  const std::size_t n = p_ + 1;
+  const std::size_t width = givens::padded(n);
+  bool prior_due = false;
+  if (lambda_ < 1.0 && ++since_prior_ >= prior_period_) {
+    since_prior_ = 0;
+    prior_due = true;
+  }
+  const std::size_t first_prior = prior_due ? next_prior_row_ : n;
+  if (prior_due) {
+    prior_work_.setZero();
+    prior_work_[static_cast<Eigen::Index>(first_prior)] = prior_weight_;
+    if (track_inverse_) prior_work_inv_.setZero();
+  }
+  if (track_inverse_) std::fill(work_inv_.data(), work_inv_.data() + p_, 0.0);
+  const bool with_coefficients = wald_block_ > 0;
+  if (with_coefficients) coef_.setZero();
+  double* beta = with_coefficients ? coef_.data() : nullptr;
+  double* w = work_.data();
+  double* prior = prior_work_.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i + 2 < n) prefetch_row(i + 2);
+    double* r = r_.row(static_cast<Eigen::Index>(i)).data();
+    const Rotation rot = rotate(r, w, i, width, sqrt_lambda_);
+    const Rotation rot_prior = i >= first_prior ? rotate(r, prior, i, width, 1.0) : Rotation{};
+    if (i < p_) {
+      if (track_inverse_) {
+        double* l = linv_.row(static_cast<Eigen::Index>(i)).data();
+        rotate_inverse(l, work_inv_.data(), i + 1, rot, inv_sqrt_lambda_);
+        if (i >= first_prior) rotate_inverse(l, prior_work_inv_.data(), i + 1, rot_prior, 1.0);
+        if (with_coefficients) {
+          const double z = r[p_];
+          const std::size_t stop = givens::padded(i + 1);  // zeros past the diagonal
+          for (std::size_t k = 0; k < stop; ++k) beta[k] += z * l[k];
+        }
+      }
+    }
+    rss_target_[static_cast<Eigen::Index>(i)] = r[p_];
+  }
+  downdate_block_covariances(1.0 / lambda_, work_inv_.data());
+  if (prior_due) {
+    downdate_block_covariances(1.0, prior_work_inv_.data());
+    next_prior_row_ = (next_prior_row_ + 1) % p_;
+  }
+  if (wald_block_ > 0) {
+    resync_block_covariance(next_resync_);
+    next_resync_ = (next_resync_ + wald_block_) % p_;
+  }
+  double sum = 0.0;
+  for (std::size_t i = n; i-- > 0;) {
+    const double v = rss_target_[static_cast<Eigen::Index>(i)];
+    sum += v * v;
+    rss_tail_[static_cast<Eigen::Index>(i)] = sum;
+  }
+  rss_stamp_ = changes_;
+  if (with_coefficients) coef_stamp_ = changes_;
 }
 
 void SqrtRls::refresh_prior() noexcept {

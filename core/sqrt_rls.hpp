@@ -128,7 +128,11 @@ class SqrtRls {
   void refresh_prior() noexcept;  // the kept-alive prior row, when due
   // Tracked block covariances: after a row, S_b = growth S_b - v_b v_b^T;
   // one block a sample recomputed from L (at regressor b0).
-  void downdate_block_covariances(double growth) noexcept;
+  void downdate_block_covariances(double growth) noexcept;  // v = work_inv_
+  void downdate_block_covariances(double growth, const double* v) noexcept;
+  // update_staged of one factor of at least kPrefetchMinRegressors: the
+  // sample, the prior row when due, beta and the RSS sums in one pass.
+  void update_in_one_pass() noexcept;
   void resync_block_covariance(std::size_t b0) noexcept;
   // L^T z, cached until the factor changes.
   const double* coefficients_from_inverse() const noexcept;
@@ -144,6 +148,11 @@ class SqrtRls {
   mutable Eigen::VectorXd coef_;   // L^T z when coef_stamp_ == changes_
   mutable std::uint64_t rss_stamp_ = ~std::uint64_t{0};
   mutable Eigen::VectorXd rss_tail_;  // rss_prefix(k) for k = 0..p when rss_stamp_ == changes_
+  // update_in_one_pass only (large factors): the prior row absorbed in the
+  // same pass as the sample, its inverse counterpart, the target column.
+  Eigen::VectorXd prior_work_;
+  Eigen::VectorXd prior_work_inv_;
+  Eigen::VectorXd rss_target_;
 };
 
 }  // namespace mpm

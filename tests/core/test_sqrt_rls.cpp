@@ -258,5 +258,46 @@ TEST(SqrtRls, WaldFallsBackWithoutTrackedInverse) {
   EXPECT_EQ(rls.rss_without_wald(5, 3, scratch), rls.rss_prefix(5));  // trailing block
 }
 
+// A large factor (the 20x20 and 50x50 monitors' full models) is updated in
+// one pass over its rows: the sample, the kept-alive prior row when due, the
+// coefficients and the RSS sums together. It must hold exactly what the
+// lockstep update of the same rows holds (two factors updated together take
+// that path), prior rows every sample (lambda 0.99), every few samples, and
+// none; the tracked block covariances agree to rounding (the one-pass update
+// re-synchronises a block after the prior row instead of before it).
+TEST(SqrtRls, LargeFactorInOnePassEqualsLockstepUpdate) {
+  const std::size_t nb = 10, m = 7, p = m * nb;  // above the one-pass threshold (64)
+  for (double lambda : {0.99, 0.999, 1.0}) {
+    SqrtRls alone(p, lambda, 1e-6, true, nb);
+    SqrtRls pair_a(p, lambda, 1e-6, true, nb);
+    SqrtRls pair_b(p, lambda, 1e-6, true, nb);
+    SqrtRls* lockstep[] = {&pair_a, &pair_b};
+    DataGen gen(static_cast<int>(p));
+    Eigen::VectorXd x(static_cast<Eigen::Index>(p));
+    double y = 0;
+    for (int k = 0; k < 3000; ++k) {
+      gen.next(x, y);
+      if (k >= 1000 && k < 1400) x.segment(nb, 2 * nb).setConstant(0.5);  // two inputs frozen
+      alone.update(x.data(), y);
+      for (SqrtRls* s : lockstep) {
+        std::copy(x.data(), x.data() + p, s->staged_row());
+        s->staged_row()[p] = y;
+      }
+      SqrtRls::update_staged(lockstep, 2);
+    }
+    EXPECT_EQ((alone.factor() - pair_a.factor()).cwiseAbs().maxCoeff(), 0.0) << lambda;
+    EXPECT_EQ((alone.inverse_factor() - pair_a.inverse_factor()).cwiseAbs().maxCoeff(), 0.0) << lambda;
+    EXPECT_EQ((pair_a.factor() - pair_b.factor()).cwiseAbs().maxCoeff(), 0.0) << lambda;
+    for (std::size_t k : {std::size_t{0}, nb, p / 2, p}) EXPECT_EQ(alone.rss_prefix(k), pair_a.rss_prefix(k)) << k;
+    SqrtRls::Matrix scratch(static_cast<Eigen::Index>(p + 1), static_cast<Eigen::Index>(p + 1));
+    for (std::size_t b = 0; b + 1 < m; ++b) {
+      const double ref = alone.rss_without(b * nb, nb, scratch);
+      EXPECT_NEAR(alone.rss_without_wald(b * nb, nb, scratch) / ref, 1.0, 1e-9) << "block " << b << " " << lambda;
+      EXPECT_NEAR(pair_a.rss_without_wald(b * nb, nb, scratch) / ref, 1.0, 1e-9) << "block " << b << " " << lambda;
+      EXPECT_GT(ref, alone.rss() * (1.0 + 1e-6)) << "block " << b;  // each block explains something
+    }
+  }
+}
+
 }  // namespace
 }  // namespace mpm
