@@ -216,10 +216,13 @@ void GrangerMonitor::absorb_sample(const double* residual) noexcept {
 }
 
 void GrangerMonitor::push_lags(const double* u, const double* residual) noexcept {
-  // Newest first: shift down by one, put time k on top (sizes are small).
-  for (Eigen::Index r = static_cast<Eigen::Index>(na_) - 1; r > 0; --r) residual_lags_.row(r) = residual_lags_.row(r - 1);
+  // Newest first: shift each output's column down by one, time k on top.
   if (na_ > 0)
-    for (std::size_t j = 0; j < n_outputs_; ++j) residual_lags_(0, static_cast<Eigen::Index>(j)) = residual[j];
+    for (std::size_t j = 0; j < n_outputs_; ++j) {
+      double* lags = residual_lags_.col(static_cast<Eigen::Index>(j)).data();
+      std::copy_backward(lags, lags + na_ - 1, lags + na_);
+      lags[0] = residual[j];
+    }
   // Laguerre network, one column per input: x_1 <- a x_1 + sqrt(1-a^2) u(k),
   // x_r <- a x_r + x_{r-1}(old) - a x_{r-1}(new). With a = 0: a shift register.
   const double a = settings_.input_pole;
@@ -229,6 +232,11 @@ void GrangerMonitor::push_lags(const double* u, const double* residual) noexcept
     double source = u[i] - input_ref_[static_cast<Eigen::Index>(i)];
     if (channel_filters_[c]) source = channel_filters_[c]->step(source);
     double* x = input_lags_.col(static_cast<Eigen::Index>(c)).data();
+    if (a == 0.0) {  // plain lags (the default): a shift register
+      std::copy_backward(x, x + nb_ - 1, x + nb_);
+      x[0] = source;
+      continue;
+    }
     double prev_old = x[0];
     x[0] = a * x[0] + gain * source;
     for (std::size_t r = 1; r < nb_; ++r) {
