@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/chi_square.hpp"
 #include "core/diagnosis_context.hpp"
 
 namespace mpm::diagnosis {
@@ -137,8 +138,39 @@ void row_hypotheses(const Context& cx, std::size_t j, std::vector<Candidate>& ou
       total += cx.gu[j * cx.n_in() + i];
     }
   if (cs.size() < 2) return;
-  auto fits = [&](double a) { return std::vector<OutputFit>{fit_output(cx, j, simulate(unit_lag(a), total) - total, {})}; };
-  const double a = minimise_on_grid(lag_pole_grid(0.3, 30.0, 16), [&](double v) { return objective(cx, fits(v)); });
+  // A transmitter lag S = (1 - a) / (1 - a q^-1) filters everything the
+  // sensor sees, the model-predicted part and the disturbances alike: the
+  // measured output is x = S x_true, with x = r + G_M u (r the residual, the
+  // accepted signals not subtracted when they are refitted jointly). Its
+  // one-step prediction error is (1 - a q^-1) x - (1 - a) G_M u, so the
+  // correction of r is c = a (x(k-1) - G_M u(k)). A lag on the model's
+  // prediction alone would leave the disturbances' part unexplained, and
+  // could not tell a sensor from a channel's own lag when one input drives
+  // the output; this form does: on a residual without a sensor lag it
+  // colours the noise and loses likelihood.
+  const OutputState& o = cx.out[j];
+  const Vec& r = o.signals.empty() ? o.d : o.base;
+  const Index n = r.size();
+  const auto fits = [&](double a) {
+    Vec c = Vec::Zero(n);
+    for (Index k = 1; k < n; ++k) c[k] = a * (r[k - 1] + total[k - 1] - total[k]);
+    return std::vector<OutputFit>{fit_output(cx, j, c, {})};
+  };
+  const std::vector<double> grid = lag_pole_grid(0.3, 30.0, 16);
+  const double a = minimise_on_grid(grid, [&](double v) { return objective(cx, fits(v)); });
+  // The same lag on the disturbances alone (a changed noise model, c = a r(k-1))
+  // must explain clearly less: what makes it a sensor is that the model's
+  // prediction is lagged too. Otherwise it is left to the disturbance-model
+  // step.
+  const auto noise_only = [&](double v) {
+    Vec c = Vec::Zero(n);
+    for (Index k = 1; k < n; ++k) c[k] = v * r[k - 1];
+    return std::vector<OutputFit>{fit_output(cx, j, c, {})};
+  };
+  const double a_noise = minimise_on_grid(grid, [&](double v) { return objective(cx, noise_only(v)); });
+  const double lr_sensor = -objective(cx, fits(a));
+  const double lr_noise = -objective(cx, noise_only(a_noise));
+  if (lr_sensor - lr_noise < chi_square_quantile_upper(cx.settings.alpha, 1.0)) return;
   Candidate c = make_candidate(cx, "sensor_dynamics", cs, fits(a), 1);
   c.finding.nominal = *cx.channel(j, cs[0].input.value());
   c.finding.fitted = series(*cx.channel(j, cs[0].input.value()), unit_lag(a));

@@ -1,0 +1,127 @@
+// The diagnosis library on one output driven by a strong and a weak input:
+// a transmitter lag filters everything the sensor sees (the model's
+// prediction and the disturbances), so it is told apart from a lag on the
+// strong input's channel alone (the disturbances unfiltered) and from a
+// changed disturbance model (the model's prediction unlagged), although all
+// three look alike in the model-predicted part.
+#include <cstddef>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/diagnosis.hpp"
+
+namespace {
+
+using mpm::DiscreteTf;
+namespace dg = mpm::diagnosis;
+
+enum class Truth { kSensorLag, kChannelLag, kNoiseModel };
+
+// First-order lag with unit gain, pole a, applied to x.
+Eigen::VectorXd lag(const Eigen::VectorXd& x, double a) {
+  Eigen::VectorXd y(x.size());
+  double s = 0.0;
+  for (Eigen::Index k = 0; k < x.size(); ++k) y(k) = s = a * s + (1.0 - a) * x(k);
+  return y;
+}
+
+// G(q) = g q^-1 / (1 - 0.8 q^-1) applied to u.
+Eigen::VectorXd channel(const Eigen::VectorXd& u, double g) {
+  Eigen::VectorXd y(u.size());
+  double s = 0.0;
+  for (Eigen::Index k = 0; k < u.size(); ++k) {
+    y(k) = s;
+    s = 0.8 * s + g * u(k);
+  }
+  return y;
+}
+
+dg::Problem one_output(Truth truth, unsigned seed) {
+  const Eigen::Index n = 6000;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  std::uniform_int_distribution<int> hold(5, 30);
+  std::uniform_real_distribution<double> level(-1.0, 1.0);
+  Eigen::VectorXd u1(n), u2(n), e(n);
+  for (Eigen::VectorXd* u : {&u1, &u2}) {
+    double v = 0.0;
+    for (Eigen::Index k = 0, next = 0; k < n; ++k) {
+      if (k == next) {
+        v = level(rng);
+        next = k + hold(rng);
+      }
+      (*u)(k) = v;
+    }
+  }
+  // Disturbances v = N e, N = 1 / (1 - 0.8 q^-1) as the plant file says
+  // (the changed-disturbance case: 1 / (1 - 0.95 q^-1) instead).
+  const double pole = truth == Truth::kNoiseModel ? 0.95 : 0.8;
+  double v = 0.0;
+  for (Eigen::Index k = 0; k < n; ++k) e(k) = v = pole * v + noise(rng);
+  const double g1 = 0.2, g2 = 0.02;  // u2 barely moves the output
+  const Eigen::VectorXd gu = channel(u1, g1) + channel(u2, g2);
+  Eigen::VectorXd y;
+  switch (truth) {
+    case Truth::kSensorLag: y = lag(gu + e, 0.5); break;
+    case Truth::kChannelLag: y = lag(channel(u1, g1), 0.5) + channel(u2, g2) + e; break;
+    case Truth::kNoiseModel: y = gu + e; break;
+  }
+  dg::Problem p;
+  p.inputs = {"u1", "u2"};
+  p.outputs = {"y"};
+  p.du.resize(n, 2);
+  p.du.col(0) = u1;
+  p.du.col(1) = u2;
+  p.u_abs = p.du;
+  p.residual = y - gu;
+  p.nominal = {DiscreteTf{{g1}, {1.0, -0.8}, 1}, DiscreteTf{{g2}, {1.0, -0.8}, 1}};
+  p.noise = {DiscreteTf{{1.0}, {1.0, -0.8}, 0}};
+  p.noise_variance = {0.1 * 0.1 / (1.0 - 0.8 * 0.8)};
+  p.monitor_flag = {true};
+  p.monitor_located = {{0}};
+  return p;
+}
+
+std::string describe(const dg::Result& r) {
+  std::string s;
+  for (const auto& f : r.findings) s += f.physics + " (" + f.summary + "); ";
+  return s.empty() ? "no findings" : s;
+}
+
+TEST(DiagnosisSensor, SensorLagNamesTheWholeOutput) {
+  for (unsigned seed : {1u, 2u}) {
+    const dg::Result r = dg::diagnose(one_output(Truth::kSensorLag, seed));
+    ASSERT_FALSE(r.findings.empty()) << "seed " << seed;
+    const dg::Finding& f = r.findings.front();
+    EXPECT_EQ(f.physics, "sensor_dynamics") << "seed " << seed << ": " << describe(r);
+    EXPECT_EQ(f.channels.size(), 2u) << "seed " << seed << ": both inputs' channels into the lagged output";
+    EXPECT_NEAR(f.parameters.at("sensor_lag_pole"), 0.5, 0.1) << "seed " << seed;
+    EXPECT_LT(f.fit.holdout_variance_after, f.fit.holdout_variance_before) << "seed " << seed;
+  }
+}
+
+TEST(DiagnosisSensor, ChannelLagIsNotASensor) {
+  for (unsigned seed : {1u, 2u}) {
+    const dg::Result r = dg::diagnose(one_output(Truth::kChannelLag, seed));
+    ASSERT_FALSE(r.findings.empty()) << "seed " << seed;
+    for (const auto& f : r.findings) EXPECT_NE(f.physics, "sensor_dynamics") << "seed " << seed << ": " << describe(r);
+    const dg::Finding& f = r.findings.front();
+    ASSERT_EQ(f.channels.size(), 1u) << "seed " << seed << ": " << describe(r);
+    EXPECT_EQ(f.channels[0].input, std::optional<std::size_t>(0)) << "seed " << seed << ": " << describe(r);
+  }
+}
+
+// (What it is called instead is not asserted: with the plant file's N and
+// slower disturbances, the whitened residual stays coloured and a process
+// hypothesis can pass its test: a known weakness.)
+TEST(DiagnosisSensor, ChangedDisturbanceModelIsNotASensor) {
+  for (unsigned seed : {1u, 2u}) {
+    const dg::Result r = dg::diagnose(one_output(Truth::kNoiseModel, seed));
+    EXPECT_TRUE(r.mismatch) << "seed " << seed;
+    for (const auto& f : r.findings) EXPECT_NE(f.physics, "sensor_dynamics") << "seed " << seed << ": " << describe(r);
+  }
+}
+
+}  // namespace
