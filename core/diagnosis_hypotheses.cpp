@@ -113,14 +113,24 @@ void integrator(const Context& cx, std::size_t j, std::size_t i, std::vector<Can
   if (p < 0.5) return;
   const DiscreteTf gi = move_pole(g, p, 1.0, 1.0);
   const Vec xi = simulate(gi, cx.problem.du.col(static_cast<Index>(i)));
+  // An integrating plant holds still only at its own balance input, which
+  // the self-regulating model's operating point need not be: under
+  // feedback the controller finds it, and the integrator sees u - u_b, not
+  // u - u0. So the balance offset is a second parameter (the channel's
+  // response to a constant, a ramp): without it any offset integrates into
+  // a drift that no gain can fit.
+  const Vec ramp = simulate(gi, Vec::Ones(xi.size()));
   const Vec& x = cx.gu[j * cx.n_in() + i];
-  OutputFit f = fit_output(cx, j, -x, {xi});
+  OutputFit f = fit_output(cx, j, -x, {xi, ramp});
   const double k = f.fit.theta(0);
-  Candidate c = make_candidate(cx, "integrator", {{j, i}}, {std::move(f)}, 1);
+  const double balance = k != 0.0 ? -f.fit.theta(1) / k : 0.0;
+  Candidate c = make_candidate(cx, "integrator", {{j, i}}, {std::move(f)}, 2);
   c.finding.nominal = g;
   c.finding.fitted = move_pole(g, p, 1.0, k);
   c.finding.parameters["integrator_gain_per_sample"] = k * g.dc_gain() * (1.0 - p);
-  c.finding.summary = arrow(cx, j, i) + " integrates: slowest pole " + fmt(p) + " -> 1, gain x " + fmt(k);
+  c.finding.parameters["balance_input_offset"] = balance;
+  c.finding.summary = arrow(cx, j, i) + " integrates: slowest pole " + fmt(p) + " -> 1, gain x " + fmt(k) +
+                      ", holding still at " + cx.problem.inputs[i] + " " + fmt(balance) + " from the model's operating point";
   out.push_back(std::move(c));
 }
 
