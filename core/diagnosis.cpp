@@ -50,20 +50,40 @@ void score(const Context& cx, Candidate& c) {
   // Out of sample: does the (whitened) correction point along the held-out
   // residual? z = <e0, w c> / (sigma0 |w c|), N(0, 1) when c is unrelated to
   // it; and the held-out variance must drop.
+  // The variance of <e0, w c> is taken with the autocovariance of the errors
+  // the candidate leaves (Bartlett window): they are white when the noise
+  // model is right and the candidate explains the mismatch, and then this is
+  // sigma0^2 |w c|^2; when the disturbances are coloured beyond what the
+  // whitener knows, a slowly varying correction lines up with them by chance
+  // far more often, and the test must not take that for evidence.
+  constexpr Index kLags = 20;
   const Index nh = cx.out.empty() ? 0 : cx.out[0].d.size();
-  double num = 0.0, den = 0.0;
+  const auto held = [&](Index k) { return k >= 0 && k < nh && cx.seg.hold[static_cast<std::size_t>(k)]; };
+  double num = 0.0, var = 0.0;
   c.hold_gain = 0.0;
   for (const auto& f : c.fits) {
     const OutputState& o = cx.out[f.output];
-    for (Index k = 0; k < nh; ++k) {
-      if (!cx.seg.hold[static_cast<std::size_t>(k)]) continue;
-      const double wc = o.hold_error(k) - f.fit.hold_error(k);
-      num += o.hold_error(k) * wc / o.hold_var;
-      den += wc * wc / o.hold_var;
+    for (Index k = 0; k < nh; ++k)
+      if (held(k)) num += o.hold_error(k) * (o.hold_error(k) - f.fit.hold_error(k));
+    for (Index l = 0; l <= kLags; ++l) {
+      double gamma = 0.0, cross = 0.0;
+      Index pairs = 0;
+      for (Index k = 0; k + l < nh; ++k) {
+        if (!held(k) || !held(k + l)) continue;
+        const double wc_k = o.hold_error(k) - f.fit.hold_error(k);
+        const double wc_l = o.hold_error(k + l) - f.fit.hold_error(k + l);
+        gamma += f.fit.hold_error(k) * f.fit.hold_error(k + l);
+        cross += wc_k * wc_l;
+        ++pairs;
+      }
+      if (pairs == 0) break;
+      gamma /= static_cast<double>(pairs);
+      const double weight = l == 0 ? 1.0 : 2.0 * (1.0 - static_cast<double>(l) / static_cast<double>(kLags + 1));
+      var += weight * gamma * cross;
     }
     c.hold_gain += std::log(o.hold_var / f.fit.hold_var);
   }
-  c.z_hold = den > 0.0 ? num / std::sqrt(den) : 0.0;
+  c.z_hold = var > 0.0 ? num / std::sqrt(var) : 0.0;
 }
 
 namespace {
