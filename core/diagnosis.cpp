@@ -1,6 +1,7 @@
 #include "core/diagnosis.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -58,28 +59,38 @@ void score(const Context& cx, Candidate& c) {
   // far more often, and the test must not take that for evidence.
   constexpr Index kLags = 20;
   const Index nh = cx.out.empty() ? 0 : cx.out[0].d.size();
-  const auto held = [&](Index k) { return k >= 0 && k < nh && cx.seg.hold[static_cast<std::size_t>(k)]; };
+  // The held-out part as runs of consecutive samples (lags stay inside one).
+  std::vector<std::pair<Index, Index>> runs;
+  for (Index k = 0; k < nh; ++k) {
+    if (!cx.seg.hold[static_cast<std::size_t>(k)]) continue;
+    if (runs.empty() || runs.back().second != k) runs.push_back({k, k});
+    runs.back().second = k + 1;
+  }
   double num = 0.0, var = 0.0;
   c.hold_gain = 0.0;
+  std::array<double, kLags + 1> gamma{}, cross{};
+  std::array<Index, kLags + 1> pairs{};
   for (const auto& f : c.fits) {
     const OutputState& o = cx.out[f.output];
-    for (Index k = 0; k < nh; ++k)
-      if (held(k)) num += o.hold_error(k) * (o.hold_error(k) - f.fit.hold_error(k));
-    for (Index l = 0; l <= kLags; ++l) {
-      double gamma = 0.0, cross = 0.0;
-      Index pairs = 0;
-      for (Index k = 0; k + l < nh; ++k) {
-        if (!held(k) || !held(k + l)) continue;
-        const double wc_k = o.hold_error(k) - f.fit.hold_error(k);
-        const double wc_l = o.hold_error(k + l) - f.fit.hold_error(k + l);
-        gamma += f.fit.hold_error(k) * f.fit.hold_error(k + l);
-        cross += wc_k * wc_l;
-        ++pairs;
+    const Vec& e1 = f.fit.hold_error;
+    const Vec wc = o.hold_error - e1;
+    gamma.fill(0.0);
+    cross.fill(0.0);
+    pairs.fill(0);
+    for (const auto& [first, end] : runs)
+      for (Index k = first; k < end; ++k) {
+        num += o.hold_error(k) * wc(k);
+        const Index last = std::min(kLags, end - 1 - k);
+        for (Index l = 0; l <= last; ++l) {
+          gamma[static_cast<std::size_t>(l)] += e1(k) * e1(k + l);
+          cross[static_cast<std::size_t>(l)] += wc(k) * wc(k + l);
+          ++pairs[static_cast<std::size_t>(l)];
+        }
       }
-      if (pairs == 0) break;
-      gamma /= static_cast<double>(pairs);
+    for (std::size_t l = 0; l <= static_cast<std::size_t>(kLags); ++l) {
+      if (pairs[l] == 0) break;
       const double weight = l == 0 ? 1.0 : 2.0 * (1.0 - static_cast<double>(l) / static_cast<double>(kLags + 1));
-      var += weight * gamma * cross;
+      var += weight * gamma[l] / static_cast<double>(pairs[l]) * cross[l];
     }
     c.hold_gain += std::log(o.hold_var / f.fit.hold_var);
   }
