@@ -217,22 +217,34 @@ const Eigen::MatrixXd& NestedRls::solve_pairs_prefix() const noexcept {
   const auto top_ld = static_cast<std::size_t>(top_.cols());
   const double* betas = pair_beta_b_.data();
   double* rhs = pair_rhs_.data();
-  const auto dot = [&](std::size_t r, std::size_t i) {
-    const double* bi = top + r * top_ld + a_ + i * nb_;
+  const auto rhs_column = [&]<std::size_t kBlocks>(std::size_t i) {
+    // kBlocks lanes per dot product when known at compile time (the short
+    // blocks of the paper's orders: straight-line code), else nb_padded.
+    const std::size_t blocks = kBlocks > 0 ? kBlocks : nb_padded / kLanes;
     const double* beta = betas + i * nb_padded;
-    Lanes acc = {};
-    for (std::size_t k = 0; k < nb_padded; k += kLanes) acc += load(bi + k) * load(beta + k);
-    return acc;
-  };
-  for (std::size_t i = 0; i < m_; ++i) {
+    const auto dot = [&](std::size_t r) {
+      const double* bi = top + r * top_ld + a_ + i * nb_;
+      Lanes acc = {};
+      for (std::size_t b = 0; b < blocks; ++b) acc += load(bi + b * kLanes) * load(beta + b * kLanes);
+      return acc;
+    };
     double* out = rhs + i * a_;
     std::size_t r = 0;
     for (; r + 4 <= a_; r += 4) {
       const Lanes y = {top[r * top_ld + target], top[(r + 1) * top_ld + target], top[(r + 2) * top_ld + target],
                        top[(r + 3) * top_ld + target]};
-      givens::store(out + r, y - givens::sum4(dot(r, i), dot(r + 1, i), dot(r + 2, i), dot(r + 3, i)));
+      givens::store(out + r, y - givens::sum4(dot(r), dot(r + 1), dot(r + 2), dot(r + 3)));
     }
-    for (; r < a_; ++r) out[r] = top[r * top_ld + target] - givens::sum(dot(r, i));
+    for (; r < a_; ++r) out[r] = top[r * top_ld + target] - givens::sum(dot(r));
+  };
+  for (std::size_t i = 0; i < m_; ++i) {
+    switch (nb_padded / kLanes) {
+      case 1: rhs_column.template operator()<1>(i); break;
+      case 2: rhs_column.template operator()<2>(i); break;
+      case 3: rhs_column.template operator()<3>(i); break;
+      case 4: rhs_column.template operator()<4>(i); break;
+      default: rhs_column.template operator()<0>(i); break;
+    }
   }
   // pair_prefix = R_AA^-1 rhs = L^T rhs, L = R_AA^-T lower triangular: each
   // block of lanes of the result sums rows r >= its first column (rows above
