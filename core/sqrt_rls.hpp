@@ -150,6 +150,9 @@ class SqrtRls {
   mutable Eigen::VectorXd rss_tail_;  // rss_prefix(k) for k = 0..p when rss_stamp_ == changes_
   // update_in_one_pass only (large factors): the prior row absorbed in the
   // same pass as the sample, its inverse counterpart, the target column.
+  // The column itself, not its squares: summed afterwards the same way as
+  // rss_prefix sums it (s += v * v, which the compiler may fuse), the RSS
+  // values are bit for bit those of the lockstep path (tested).
   Eigen::VectorXd prior_work_;
   Eigen::VectorXd prior_work_inv_;
   Eigen::VectorXd rss_target_;
