@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "core/diagnosis.hpp"
+#include "support/diagnosis_problem.hpp"
 
 namespace {
 
@@ -47,21 +48,12 @@ dg::Problem regulation_loop(unsigned seed, double plant_gain = 1.0) {
     x = 0.9 * x + 0.1 * plant_gain * (u(i) + z_in(i));
     xm = 0.9 * xm + 0.1 * u(i);
   }
-  dg::Problem p;
-  p.inputs = {"u"};
-  p.outputs = {"y"};
-  p.du = u;
-  p.u_abs = u;
-  p.residual = y - gu;
+  dg::Problem p = mpm::test::one_output_problem({"u"}, u, y - gu, {DiscreteTf{{0.1}, {1.0, -0.9}, 1}},
+                                                 DiscreteTf{{1.0}, {1.0}, 0}, 0.05 * 0.05);
   p.extra_names = {"z_in", "z_out"};
   p.extra.resize(static_cast<Eigen::Index>(n), 2);
   p.extra.col(0) = z_in;
   p.extra.col(1) = z_out;
-  p.nominal = {DiscreteTf{{0.1}, {1.0, -0.9}, 1}};
-  p.noise = {DiscreteTf{{1.0}, {1.0}, 0}};
-  p.noise_variance = {0.05 * 0.05};
-  p.monitor_flag = {true};
-  p.monitor_located = {{0}};
   return p;
 }
 

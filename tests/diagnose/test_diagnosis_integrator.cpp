@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "core/diagnosis.hpp"
+#include "support/diagnosis_problem.hpp"
 
 namespace {
 
@@ -35,18 +36,8 @@ dg::Problem integrating_loop(unsigned seed, double balance) {
     x += 0.035 * (u(i) - balance);
     xm = 0.975 * xm + 0.05 * u(i);
   }
-  dg::Problem p;
-  p.inputs = {"u"};
-  p.outputs = {"y"};
-  p.du = u;
-  p.u_abs = u;
-  p.residual = y - gu;
-  p.nominal = {DiscreteTf{{0.05}, {1.0, -0.975}, 1}};
-  p.noise = {DiscreteTf{{1.0}, {1.0}, 0}};
-  p.noise_variance = {0.02 * 0.02};
-  p.monitor_flag = {true};
-  p.monitor_located = {{0}};
-  return p;
+  return mpm::test::one_output_problem({"u"}, u, y - gu, {DiscreteTf{{0.05}, {1.0, -0.975}, 1}},
+                                      DiscreteTf{{1.0}, {1.0}, 0}, 0.02 * 0.02);
 }
 
 TEST(DiagnosisIntegrator, IntegratorAwayFromTheModelsOperatingPoint) {

@@ -8,10 +8,12 @@
 #include <random>
 #include <string>
 #include <tuple>
+#include <utility>
 
 #include <gtest/gtest.h>
 
 #include "core/diagnosis.hpp"
+#include "support/diagnosis_problem.hpp"
 
 namespace {
 
@@ -69,20 +71,12 @@ dg::Problem one_output(Truth truth, unsigned seed, double declared = 0.8, double
     case Truth::kChannelLag: y = lag(channel(u1, g1), 0.5) + channel(u2, g2) + e; break;
     case Truth::kNoiseModel: y = gu + e; break;
   }
-  dg::Problem p;
-  p.inputs = {"u1", "u2"};
-  p.outputs = {"y"};
-  p.du.resize(n, 2);
-  p.du.col(0) = u1;
-  p.du.col(1) = u2;
-  p.u_abs = p.du;
-  p.residual = y - gu;
-  p.nominal = {DiscreteTf{{g1}, {1.0, -0.8}, 1}, DiscreteTf{{g2}, {1.0, -0.8}, 1}};
-  p.noise = {DiscreteTf{{1.0}, {1.0, -declared}, 0}};
-  p.noise_variance = {sd * sd / (1.0 - declared * declared)};
-  p.monitor_flag = {true};
-  p.monitor_located = {{0}};
-  return p;
+  Eigen::MatrixXd du(n, 2);
+  du.col(0) = u1;
+  du.col(1) = u2;
+  return mpm::test::one_output_problem({"u1", "u2"}, std::move(du), y - gu,
+                                      {DiscreteTf{{g1}, {1.0, -0.8}, 1}, DiscreteTf{{g2}, {1.0, -0.8}, 1}},
+                                      DiscreteTf{{1.0}, {1.0, -declared}, 0}, sd * sd / (1.0 - declared * declared));
 }
 
 std::string describe(const dg::Result& r) {
