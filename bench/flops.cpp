@@ -43,11 +43,26 @@ double absorb_flops(std::size_t first, std::size_t p, bool track_inverse, bool i
   return f;
 }
 
+// rotate_sqrt_free(u, d, b, w, first, end, lambda): lambda d, w x, the new
+// weight lambda d + w x x (2), its reciprocal, cbar, sbar, w cbar: 8; then
+// b - x u (2) and cbar u + sbar b (3) for each of the `tail` columns after
+// `first`.
+double ud_rotation_flops(std::size_t tail) { return 8.0 + 5.0 * d(tail); }
+
+// UdRls absorbing a row of p regressors + target from row `first` on.
+double ud_absorb_flops(std::size_t first, std::size_t p) {
+  double f = 0.0;
+  for (std::size_t i = first; i <= p; ++i) f += ud_rotation_flops(p - i);
+  return f;
+}
+
 // Sum of squares of `terms` values: a multiply and an add each.
 double sum_of_squares_flops(std::size_t terms) { return 2.0 * d(terms); }
 
 // SqrtRls::rss_prefix(k) of a model with p regressors: rows k..p.
 double rss_prefix_flops(std::size_t p, std::size_t k) { return sum_of_squares_flops(p + 1 - k); }
+// UdRls::rss_prefix(k): d_p, then d_i z_i^2 added for rows k..p-1 (3 each).
+double ud_rss_prefix_flops(std::size_t p, std::size_t k) { return 3.0 * d(p - k); }
 
 }  // namespace
 
@@ -62,6 +77,33 @@ double sqrt_rls_update_flops(std::size_t p, double lambda, bool track_inverse) {
     for (std::size_t r = 0; r < p; ++r) prior += absorb_flops(r, p, track_inverse, true);
     f += prior / d(p) / static_cast<double>(prior_refresh_period(p, lambda));
   }
+  return f;
+}
+
+double ud_rls_update_flops(std::size_t p, double lambda) {
+  double f = ud_absorb_flops(0, p);
+  if (lambda < 1.0) {
+    double prior = 0.0;
+    for (std::size_t r = 0; r < p; ++r) prior += ud_absorb_flops(r, p);
+    f += prior / d(p) / static_cast<double>(prior_refresh_period(p, lambda));
+  }
+  return f;
+}
+
+double ud_rss_without_flops(std::size_t p, std::size_t first, std::size_t count) {
+  if (count == 0) return ud_rss_prefix_flops(p, p);
+  if (first + count >= p + 1) return ud_rss_prefix_flops(p, first);
+  // The rows of R = D^1/2 U copied into scratch: a square root per row and a
+  // product per copied entry; then SqrtRls's re-triangularisation.
+  const std::size_t rows = p + 1 - first;
+  const std::size_t cols = p + 1 - first - count;
+  return d(rows) * (1.0 + d(cols)) + rss_without_flops(p, first, count);
+}
+
+double ud_solve_prefix_flops(std::size_t k) {
+  // Unit diagonal: coefficient i costs its i multiply-subtracts only.
+  double f = 0.0;
+  for (std::size_t i = 0; i < k; ++i) f += 2.0 * d(i);
   return f;
 }
 
@@ -162,28 +204,31 @@ namespace {
 // NestedRls of the output: prefix a = 1 + na, lower factor of P = m nb
 // regressors, pairwise factors of nb (the first input's: a prefix of the
 // lower factor).
-double statistics_flops(std::size_t inputs, std::size_t na, std::size_t nb, bool gamma) {
+double statistics_flops(std::size_t inputs, std::size_t na, std::size_t nb, bool gamma, bool wald) {
   const std::size_t a = 1 + na;
   const std::size_t p_lower = inputs * nb;
+  const auto lower_rss_prefix = [&](std::size_t k) {
+    return wald ? rss_prefix_flops(p_lower, k) : ud_rss_prefix_flops(p_lower, k);
+  };
   // rss_full, rss_prefix_only, rss_head(1) (rss_prefix_only again plus the
-  // a - 1 trapezoid rows); three divisions by sum_w; lr_joint: division,
-  // log, product; gamma_lambda^2.
-  double f = rss_prefix_flops(p_lower, p_lower) + 2.0 * rss_prefix_flops(p_lower, 0) + sum_of_squares_flops(a - 1) +
-             1.0 + 3.0 + 3.0 + 1.0;
+  // a - 1 trapezoid rows' d z^2, 3 each); three divisions by sum_w;
+  // lr_joint: division, log, product; gamma_lambda^2.
+  double f = lower_rss_prefix(p_lower) + 2.0 * lower_rss_prefix(0) + 3.0 * d(a - 1) + 1.0 + 3.0 + 3.0 + 1.0;
   for (std::size_t i = 0; i < inputs; ++i) {
     f += 3.0;  // f_conditional (division, log), lr_conditional
     // Pairwise F: its A-only RSS and its RSS (input 0: prefix sums of the
-    // lower factor; else the pairwise factor's), division, log, product.
-    f += i == 0 ? rss_prefix_flops(p_lower, 0) + rss_prefix_flops(p_lower, nb)
-                : rss_prefix_flops(nb, 0) + rss_prefix_flops(nb, nb);
+    // lower factor; else the pairwise UdRls's), division, log, product.
+    f += i == 0 ? lower_rss_prefix(0) + lower_rss_prefix(nb) : ud_rss_prefix_flops(nb, 0) + ud_rss_prefix_flops(nb, nb);
     f += 3.0;
     if (gamma) {
       // solve_pairs_prefix, this input's share: nb coefficients of its block
       // (back substitution), the trapezoid's right-hand side (a rows of nb
-      // multiply-subtracts) and its product with the tracked R_AA^-T (a
-      // triangle of multiply-adds); |g_hat - g_N|^2: na subtractions, na
-      // products, na - 1 adds; 1 + |g_N|^2: 2 na; the quotient: 1.
-      f += solve_prefix_flops(nb) + 2.0 * d(a) * d(nb) + d(a) * d(a + 1);
+      // multiply-subtracts) and the back substitution with the unit U_AA
+      // (a (a - 1) / 2 multiply-subtracts); |g_hat - g_N|^2: na
+      // subtractions, na products, na - 1 adds; 1 + |g_N|^2: 2 na; the
+      // quotient: 1.
+      f += (i == 0 && wald ? solve_prefix_flops(nb) : ud_solve_prefix_flops(nb)) + 2.0 * d(a) * d(nb) +
+           d(a) * d(a - 1);
       f += 3.0 * d(na) - 1.0 + 2.0 * d(na) + 1.0;
     }
   }
@@ -210,40 +255,46 @@ MonitorFlops monitor_flops(std::size_t inputs, std::size_t outputs, const Monito
   const bool wald = inputs >= kWaldMinInputs;
   const double n_out = d(outputs);
   MonitorFlops f;
-  // NestedRls per output: the trapezoid of the a prefix rows (rotation i
-  // over the columns after i), the lower factor, and every K_a samples the
-  // trapezoid's prior row (from a round-robin row r) passed on to the lower
-  // and pairwise factors with weight 1.
+  // NestedRls per output: the trapezoid of the a prefix rows (square-root
+  // free rotation i over the columns after i), the lower factor (a SqrtRls
+  // with its inverse takes the row scaled by sqrt(weight): a square root and
+  // a product per column), and every K_a samples the trapezoid's prior row
+  // (from a round-robin row r) passed on to the lower and pairwise factors.
   double shared = 0.0;
-  // (Each trapezoid rotation also turns the tracked R_AA^-T's row i.)
-  for (std::size_t i = 0; i < a; ++i) shared += rotation_flops(cols - 1 - i) + inverse_rotation_flops(i + 1, false);
-  shared += sqrt_rls_update_flops(p_lower, lambda, wald);
-  if (wald) shared += tracked_blocks_update_flops(p_lower, nb, lambda);
+  for (std::size_t i = 0; i < a; ++i) shared += ud_rotation_flops(cols - 1 - i);
+  if (wald) {
+    shared += 1.0 + d(p_lower + 1) + sqrt_rls_update_flops(p_lower, lambda, true);
+    shared += tracked_blocks_update_flops(p_lower, nb, lambda);
+  } else {
+    shared += ud_rls_update_flops(p_lower, lambda);
+  }
   if (lambda < 1.0) {
     double prior = 0.0;
     for (std::size_t r = 0; r < a; ++r)
-      for (std::size_t i = r; i < a; ++i) prior += rotation_flops(cols - 1 - i) + inverse_rotation_flops(i + 1, true);
+      for (std::size_t i = r; i < a; ++i) prior += ud_rotation_flops(cols - 1 - i);
     prior /= d(a);
-    prior += absorb_flops(0, p_lower, wald, true) + d(inputs - 1) * absorb_flops(0, nb, false, true);
+    prior += wald ? 1.0 + d(p_lower + 1) + absorb_flops(0, p_lower, true, true) : ud_absorb_flops(0, p_lower);
+    prior += d(inputs - 1) * ud_absorb_flops(0, nb);
     shared += prior / static_cast<double>(prior_refresh_period(a, lambda));
   }
   f.full_updates = n_out * shared;
-  f.pairwise_updates = n_out * d(inputs - 1) * sqrt_rls_update_flops(nb, lambda, false);
+  f.pairwise_updates = n_out * d(inputs - 1) * ud_rls_update_flops(nb, lambda);
   // rss_without_block: one input, the prefix-only RSS; two, a pairwise RSS
   // or a prefix sum; more, rss_without_wald on the lower factor (which falls
   // back to rss_without without the inverse, except for the trailing block).
   double conditional = 0.0;
   for (std::size_t i = 0; i < inputs; ++i) {
     const std::size_t first = i * nb;
-    if (inputs == 1) conditional += rss_prefix_flops(p_lower, 0);
-    else if (inputs == 2) conditional += i == 0 ? rss_prefix_flops(nb, nb) : rss_prefix_flops(p_lower, nb);
-    else if (first + nb >= p_lower) conditional += rss_without_wald_flops(p_lower, first, nb);  // trailing: prefix sum
-    else conditional += wald ? tracked_block_wald_flops(p_lower, nb) : rss_without_flops(p_lower, first, nb);
+    if (inputs == 1) conditional += ud_rss_prefix_flops(p_lower, 0);
+    else if (inputs == 2) conditional += i == 0 ? ud_rss_prefix_flops(nb, nb) : ud_rss_prefix_flops(p_lower, nb);
+    else if (!wald) conditional += ud_rss_without_flops(p_lower, first, nb);  // trailing block: a prefix sum
+    else if (first + nb >= p_lower) conditional += rss_without_wald_flops(p_lower, first, nb);
+    else conditional += tracked_block_wald_flops(p_lower, nb);
   }
   f.conditional = n_out * conditional;
   // absorb_sample's weights (sum_w 2, sum_w2 3, n_eq 2) and update_statistics'
   // two scales (2), once per update.
-  f.other_statistics = 9.0 + n_out * statistics_flops(inputs, na, nb, options.gamma);
+  f.other_statistics = 9.0 + n_out * statistics_flops(inputs, na, nb, options.gamma, wald);
   // gain = sqrt(1 - a^2) once; per output the divergence check (dev 1, mean
   // 2, variance 4, baseline test 1; the reference test 1 only when known,
   // not counted); per channel the regressor push.

@@ -1,5 +1,5 @@
 // Floating-point work of one monitor update, counted analytically from the
-// algorithm in core/sqrt_rls.cpp, core/nested_rls.cpp and
+// algorithm in core/sqrt_rls.cpp, core/ud_rls.cpp, core/nested_rls.cpp and
 // core/granger_monitor.cpp, and the
 // core's peak rate, measured by an FMA-throughput loop.
 //
@@ -29,12 +29,17 @@ namespace mpm::bench {
 // the p round-robin starting rows).
 double sqrt_rls_update_flops(std::size_t p, double lambda, bool track_inverse);
 double sqrt_rls_update_flops(std::size_t, bool, bool) = delete;  // lambda is a number, not a flag
+// The same for UdRls (square-root-free rotations, no inverse).
+double ud_rls_update_flops(std::size_t p, double lambda);
+double ud_rls_update_flops(std::size_t, bool) = delete;
 // The prior's refresh period K the core uses for p regressors and lambda
 // (core/givens.hpp).
 int prior_refresh_period(std::size_t p, double lambda);
 // Flops of SqrtRls::rss_without(first, count) for p regressors (Householder
 // re-triangularisation of the trailing block).
 double rss_without_flops(std::size_t p, std::size_t first, std::size_t count);
+// The same for UdRls::rss_without (R's rows formed from D and U first).
+double ud_rss_without_flops(std::size_t p, std::size_t first, std::size_t count);
 // Flops of SqrtRls::rss_without_wald(first, count) with the inverse tracked
 // (Gram matrix of the block's columns of R^-T, Cholesky, forward solve).
 double rss_without_wald_flops(std::size_t p, std::size_t first, std::size_t count);
@@ -42,13 +47,15 @@ double rss_without_wald_flops(std::size_t p, std::size_t first, std::size_t coun
 // upkeep, and one block's rss_without_wald.
 double tracked_blocks_update_flops(std::size_t p, std::size_t block, double lambda);
 double tracked_block_wald_flops(std::size_t p, std::size_t count);
-// Flops of SqrtRls::solve_prefix(k).
+// Flops of SqrtRls::solve_prefix(k), and of UdRls's (unit diagonal).
 double solve_prefix_flops(std::size_t k);
+double ud_solve_prefix_flops(std::size_t k);
 
 struct MonitorFlops {
   double full_updates = 0.0;      // one NestedRls per output: the shared rows of
-                                  // [1, AR] and the lower factor of m nb (with
-                                  // its inverse when m >= kWaldMinInputs)
+                                  // [1, AR] and the lower factor of m nb (a
+                                  // SqrtRls with its inverse when m >=
+                                  // kWaldMinInputs, else a UdRls)
   double pairwise_updates = 0.0;  // m - 1 pairwise lower factors of nb per
                                   // output (the first input's is a prefix)
   double conditional = 0.0;       // rss_without_block per (output, input)

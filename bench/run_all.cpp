@@ -138,11 +138,12 @@ void limit_figures(Plan& plan) {
       if (f.name == name) return f.value;
     return std::nullopt;
   };
-  plan.say("latency of one rotation step (dependent sqrt + divide)");
-  const double step_ns = measure_sqrt_div_step_ns(plan.quick() ? 0.02 : 0.2);
+  plan.say("latency of one rotation step (the dependent division)");
+  const double step_ns = measure_rotation_step_ns(plan.quick() ? 0.02 : 0.2);
   const std::size_t chain = rotation_chain_length(2, s);
   plan.add("rotation_step_ns", step_ns, "ns",
-           "measured: dependent chain r <- 1/sqrt(r r + c), the part of a Givens rotation the next one waits on");
+           "measured: dependent chain w <- (w f) / (f + w c), the part of a square-root-free rotation the next one "
+           "waits on (a multiply-add, a division, a product)");
   const auto update_2x2 = measured("update_ns_2x2");
   plan.add("latency_floor_ns_2x2", static_cast<double>(chain) * step_ns, "ns",
            fmt("%.0f dependent rotations per output (the rows of [1, AR], then the inputs' factor) x rotation_step_ns; "

@@ -1,7 +1,8 @@
 // OVERVIEW
-// The Givens rotation shared by the square-root RLS factors (sqrt_rls.cpp,
-// nested_rls.cpp), with the forgetting factor folded in, and the period of
-// the kept-alive prior row both use.
+// The Givens rotations shared by the RLS factors: the square-root one
+// (sqrt_rls.cpp, R itself) with the forgetting factor folded in, the
+// square-root-free one (ud_rls.cpp, nested_rls.cpp: R = D^1/2 U), and the
+// period of the kept-alive prior row all use.
 #pragma once
 
 #include <algorithm>
@@ -115,6 +116,51 @@ inline void rotate_inverse(double* __restrict a, double* __restrict b, std::size
     const Lanes bj = load(b + j);
     store(a + j, ci * aj + rot.s * bj);
     store(b + j, rot.c * bj - si * aj);
+  }
+}
+
+// Gentleman's square-root-free Givens rotation (Gentleman 1973; the update
+// of Miller's AS 274), for factors kept as R = D^1/2 U with U unit upper
+// triangular: absorbs row b, of weight w, into row `first` of U (u) and its
+// diagonal weight d, d forgotten by lambda first, so that b[first] becomes
+// 0. w leaves as the weight of what is left of b. Per entry three
+// operations (two fused) instead of the Givens rotation's four, and no
+// square root: the chain from one row to the next is one division. Same layout
+// rules as rotate(): `end` padded, columns before `first` in its block of
+// lanes zero in both rows and kept zero.
+inline void rotate_sqrt_free(double* __restrict u, double& d, double* __restrict b, double& w, std::size_t first,
+                             std::size_t end, double lambda) noexcept {
+  const double x = b[first];
+  const double forgotten = lambda * d;
+  if (x == 0.0 || w == 0.0) {  // nothing of this row enters row `first`
+    d = forgotten;
+    return;
+  }
+  // The next row waits on w only: w lambda d and x x are formed beside the
+  // chain, which is one multiply-add, the division and one product.
+  const double grown = forgotten + w * (x * x);
+  const double inv = 1.0 / grown;
+  const double cbar = forgotten * inv;
+  const double sbar = (w * x) * inv;
+  d = grown;
+  w = (w * forgotten) * inv;
+  const std::size_t begin = first / kLanes * kLanes;
+  {
+    // The diagonal stays exactly 1 and b[first] exactly 0 (lane masks, as in
+    // rotate()): computed, they would be 1 and 0 only up to rounding, and the
+    // error would leak below the diagonal.
+    const Lanes u0 = load(u + begin);
+    const Lanes b0 = load(b + begin);
+    const LaneMask at_first = kLaneIndex == static_cast<long long>(first - begin);
+    const Lanes zero = {0.0, 0.0, 0.0, 0.0};
+    store(b + begin, at_first ? zero : b0 - x * u0);
+    store(u + begin, at_first ? 1.0 + zero : cbar * u0 + sbar * b0);
+  }
+  for (std::size_t j = begin + kLanes; j < end; j += kLanes) {
+    const Lanes uj = load(u + j);
+    const Lanes bj = load(b + j);
+    store(b + j, bj - x * uj);
+    store(u + j, cbar * uj + sbar * bj);
   }
 }
 

@@ -10,7 +10,7 @@ namespace mpm {
 namespace {
 
 // Lower factors updated together (SqrtRls::update_staged): enough
-// independent rotation chains to hide the square-root and division latency.
+// independent rotation chains to hide the divisions' latency.
 constexpr std::size_t kLockstep = 8;
 // Factors with more regressors than this are updated alone: their rows are
 // long enough to hide the latency by themselves, and one factor at a time
@@ -26,10 +26,10 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
       m_(blocks),
       nb_(block_size),
       cols_(prefix + blocks * block_size + 1),
-      sqrt_lambda_(std::sqrt(forgetting)),
-      inv_sqrt_lambda_(1.0 / std::sqrt(forgetting)),
+      lambda_(forgetting),
       delta_(regularization),
-      forgets_(forgetting < 1.0) {
+      forgets_(forgetting < 1.0),
+      wald_(track_inverse) {
   if (prefix == 0 || blocks == 0 || block_size == 0)
     throw std::invalid_argument("NestedRls: need a prefix and at least one block of regressors");
   if (!(forgetting > 0.0 && forgetting <= 1.0)) throw std::invalid_argument("NestedRls: forgetting must be in (0, 1]");
@@ -39,11 +39,11 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
   // One spare block of lanes past the padded width (always zero): whole-lane
   // reads of a block of B columns may run past the last one.
   top_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(givens::padded(cols_) + givens::kLanes));
-  lower_ = SqrtRls(m_ * nb_, forgetting, regularization, track_inverse, track_inverse ? nb_ : 0);
-  pairs_.assign(m_ - 1, SqrtRls(nb_, forgetting, regularization));
+  top_d_.resize(static_cast<Eigen::Index>(a_));
+  if (wald_) lower_wald_ = SqrtRls(m_ * nb_, forgetting, regularization, true, nb_);
+  else lower_ = UdRls(m_ * nb_, forgetting, regularization);
+  pairs_.assign(m_ - 1, UdRls(nb_, forgetting, regularization));
   row_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(givens::padded(cols_)));
-  top_inv_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(givens::padded(a_)));
-  row_inv_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(givens::padded(a_)));
   pair_rhs_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(m_));
   coef_b_.resize(static_cast<Eigen::Index>(m_ * nb_));
   pair_beta_b_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(givens::padded(nb_)), static_cast<Eigen::Index>(m_));
@@ -53,47 +53,55 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
 
 void NestedRls::reset() noexcept {
   top_.setZero();
-  top_inv_.setZero();
-  for (std::size_t i = 0; i < a_; ++i) {
-    const auto ii = static_cast<Eigen::Index>(i);
-    top_(ii, ii) = std::sqrt(delta_);
-    top_inv_(ii, ii) = 1.0 / std::sqrt(delta_);
-  }
-  lower_.reset();
-  for (SqrtRls& p : pairs_) p.reset();
+  for (std::size_t i = 0; i < a_; ++i) top_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = 1.0;
+  top_d_.setConstant(delta_);
+  if (wald_) lower_wald_.reset();
+  else lower_.reset();
+  for (UdRls& p : pairs_) p.reset();
   since_prior_ = 0;
   next_prior_row_ = 0;
 }
 
-void NestedRls::absorb_top(std::size_t first, double scale) noexcept {
-  row_inv_.setZero();
-  for (std::size_t i = first; i < a_; ++i) rotate_top_row(i, scale);
-}
-
-// Inlined into the lockstep loop, as SqrtRls::absorb_row.
-[[gnu::always_inline]] inline void NestedRls::rotate_top_row(std::size_t i, double scale) noexcept {
-  const auto ii = static_cast<Eigen::Index>(i);
-  const givens::Rotation rot = givens::rotate(top_.row(ii).data(), row_.data(), i, givens::padded(cols_), scale);
-  const double inv_scale = scale == sqrt_lambda_ ? inv_sqrt_lambda_ : 1.0 / scale;
-  givens::rotate_inverse(top_inv_.row(ii).data(), row_inv_.data(), i + 1, rot, inv_scale);
+void NestedRls::absorb_top(std::size_t first, double lambda) noexcept {
+  const std::size_t end = givens::padded(cols_);
+  for (std::size_t i = first; i < a_; ++i)
+    givens::rotate_sqrt_free(top_.row(static_cast<Eigen::Index>(i)).data(), top_d_[static_cast<Eigen::Index>(i)],
+                             row_.data(), row_weight_, i, end, lambda);
 }
 
 void NestedRls::stage_lowers() noexcept {
   const double* w = row_.data();
   const double y = w[cols_ - 1];
-  std::copy(w + a_, w + cols_, lower_.staged_row());  // B_1 .. B_m, y
+  if (wald_) {
+    // A SqrtRls takes rows of weight 1: the row scaled by sqrt(weight).
+    const double scale = std::sqrt(row_weight_);
+    double* q = lower_wald_.staged_row();
+    for (std::size_t c = a_; c < cols_; ++c) q[c - a_] = scale * w[c];
+  } else {
+    std::copy(w + a_, w + cols_, lower_.staged_row());  // B_1 .. B_m, y
+    lower_.stage_weight(row_weight_);
+  }
   for (std::size_t i = 1; i < m_; ++i) {
-    double* q = pairs_[i - 1].staged_row();
+    UdRls& pair = pairs_[i - 1];
+    double* q = pair.staged_row();
     std::copy(w + a_ + i * nb_, w + a_ + (i + 1) * nb_, q);
     q[nb_] = y;
+    pair.stage_weight(row_weight_);
   }
 }
 
 void NestedRls::add_to_lowers() noexcept {
   const double* w = row_.data();
   const double y = w[cols_ - 1];
-  lower_.add_row(w + a_, y);
-  for (std::size_t i = 1; i < m_; ++i) pairs_[i - 1].add_row(w + a_ + i * nb_, y);
+  if (wald_) {
+    const double scale = std::sqrt(row_weight_);
+    double* q = lower_wald_.staged_row();  // free between updates: add_row copies from it
+    for (std::size_t c = a_; c < cols_; ++c) q[c - a_] = scale * w[c];
+    lower_wald_.add_row(q, q[cols_ - 1 - a_]);
+  } else {
+    lower_.add_row(w + a_, y, row_weight_);
+  }
+  for (std::size_t i = 1; i < m_; ++i) pairs_[i - 1].add_row(w + a_ + i * nb_, y, row_weight_);
 }
 
 void NestedRls::update(const double* x, double y) noexcept {
@@ -104,35 +112,52 @@ void NestedRls::update(const double* x, double y) noexcept {
 
 void NestedRls::update_staged(NestedRls* models, std::size_t count) noexcept {
   // The trapezoids' rotation i of every model, then rotation i + 1, so the
-  // models' chains of dependent square roots and divisions overlap.
+  // models' chains of dependent divisions overlap.
   std::size_t rows = 0;
-  for (std::size_t k = 0; k < count; ++k) rows = std::max(rows, models[k].a_);
-  for (std::size_t k = 0; k < count; ++k) models[k].row_inv_.setZero();
+  for (std::size_t k = 0; k < count; ++k) {
+    rows = std::max(rows, models[k].a_);
+    models[k].row_weight_ = 1.0;
+  }
   for (std::size_t i = 0; i < rows; ++i)
-    for (std::size_t k = 0; k < count; ++k)
-      if (i < models[k].a_) models[k].rotate_top_row(i, models[k].sqrt_lambda_);
+    for (std::size_t k = 0; k < count; ++k) {
+      NestedRls& n = models[k];
+      if (i < n.a_)
+        givens::rotate_sqrt_free(n.top_.row(static_cast<Eigen::Index>(i)).data(), n.top_d_[static_cast<Eigen::Index>(i)],
+                                 n.row_.data(), n.row_weight_, i, givens::padded(n.cols_), n.lambda_);
+    }
   // Then every lower factor, a few at a time.
-  SqrtRls* group[kLockstep];
+  UdRls* group[kLockstep];
   std::size_t in_group = 0;
-  const auto add = [&](SqrtRls& lower) {
+  SqrtRls* wald_group[kLockstep];
+  std::size_t in_wald_group = 0;
+  const auto add = [&](UdRls& lower) {
+    group[in_group++] = &lower;
+    if (in_group == kLockstep) {
+      UdRls::update_staged(group, in_group);
+      in_group = 0;
+    }
+  };
+  const auto add_wald = [&](SqrtRls& lower) {
     if (lower.n_regressors() > kLockstepMaxRegressors) {
       SqrtRls* alone = &lower;
       SqrtRls::update_staged(&alone, 1);
       return;
     }
-    group[in_group++] = &lower;
-    if (in_group == kLockstep) {
-      SqrtRls::update_staged(group, in_group);
-      in_group = 0;
+    wald_group[in_wald_group++] = &lower;
+    if (in_wald_group == kLockstep) {
+      SqrtRls::update_staged(wald_group, in_wald_group);
+      in_wald_group = 0;
     }
   };
   for (std::size_t k = 0; k < count; ++k) {
     NestedRls& n = models[k];
     n.stage_lowers();
-    add(n.lower_);
-    for (SqrtRls& p : n.pairs_) add(p);
+    if (n.wald_) add_wald(n.lower_wald_);
+    else add(n.lower_);
+    for (UdRls& p : n.pairs_) add(p);
   }
-  if (in_group > 0) SqrtRls::update_staged(group, in_group);
+  if (in_group > 0) UdRls::update_staged(group, in_group);
+  if (in_wald_group > 0) SqrtRls::update_staged(wald_group, in_wald_group);
   for (std::size_t k = 0; k < count; ++k) models[k].refresh_prior();
 }
 
@@ -142,6 +167,7 @@ void NestedRls::refresh_prior() noexcept {
   double* w = row_.data();
   std::fill(w, w + cols_, 0.0);
   w[next_prior_row_] = prior_weight_;
+  row_weight_ = 1.0;
   absorb_top(next_prior_row_, 1.0);
   add_to_lowers();
   next_prior_row_ = (next_prior_row_ + 1) % a_;
@@ -151,41 +177,69 @@ double NestedRls::rss_head(std::size_t k) const noexcept {
   const auto target = static_cast<Eigen::Index>(cols_ - 1);
   double s = rss_prefix_only();
   for (std::size_t r = k; r < a_; ++r) {
-    const double v = top_(static_cast<Eigen::Index>(r), target);
-    s += v * v;
+    const auto rr = static_cast<Eigen::Index>(r);
+    const double z = top_(rr, target);
+    s += top_d_[rr] * (z * z);
   }
   return s;
 }
 
 double NestedRls::rss_pair(std::size_t i) const noexcept {
-  return i == 0 ? lower_.rss_prefix(nb_) : pairs_[i - 1].rss();
+  return i == 0 ? lower_rss_prefix(nb_) : pairs_[i - 1].rss();
 }
 
 double NestedRls::rss_pair_prefix_only(std::size_t i) const noexcept {
-  return i == 0 ? lower_.rss_prefix(0) : pairs_[i - 1].rss_prefix(0);
+  return i == 0 ? lower_rss_prefix(0) : pairs_[i - 1].rss_prefix(0);
 }
 
 double NestedRls::rss_without_block(std::size_t i, Matrix& scratch) const noexcept {
   if (m_ == 1) return rss_prefix_only();
   // Two inputs: the model without one is the pairwise model of the other.
-  if (m_ == 2) return i == 0 ? pairs_[0].rss() : lower_.rss_prefix(nb_);
-  return lower_.rss_without_wald(i * nb_, nb_, scratch);
+  if (m_ == 2) return i == 0 ? pairs_[0].rss() : lower_rss_prefix(nb_);
+  return wald_ ? lower_wald_.rss_without_wald(i * nb_, nb_, scratch) : lower_.rss_without(i * nb_, nb_, scratch);
 }
 
-void NestedRls::apply_top_inverse(const double* rhs, double* out) const noexcept {
-  // out = R_AA^-1 rhs = L^T rhs with L = R_AA^-T lower triangular and
-  // row-major: an AXPY of row r of L per right-hand side entry, with no
-  // dependency chain (a back substitution waits on every coefficient in turn).
-  std::fill(out, out + a_, 0.0);
-  for (std::size_t r = 0; r < a_; ++r) {
-    const double* l = top_inv_.row(static_cast<Eigen::Index>(r)).data();
-    const double t = rhs[r];
-    for (std::size_t k = 0; k <= r; ++k) out[k] += t * l[k];
+void NestedRls::lower_solve_prefix(std::size_t k, double* out, bool padded) const noexcept {
+  if (wald_) {
+    if (padded) lower_wald_.solve_prefix_padded(k, out);
+    else lower_wald_.solve_prefix(k, Eigen::Map<Eigen::VectorXd>(out, static_cast<Eigen::Index>(k)));
+  } else {
+    if (padded) lower_.solve_prefix_padded(k, out);
+    else lower_.solve_prefix(k, Eigen::Map<Eigen::VectorXd>(out, static_cast<Eigen::Index>(k)));
+  }
+}
+
+void NestedRls::solve_top_unit(const double* rhs, std::size_t count, double* out, std::size_t out_stride) const noexcept {
+  // Back substitution with the unit diagonal of U_AA, column by column (one
+  // product and one update per coefficient on the dependency chain), two
+  // right-hand sides sharing each load of U.
+  const double* __restrict u = top_.data();
+  const auto ld = static_cast<std::size_t>(top_.cols());
+  for (std::size_t i = 0; i < count; i += 2) {
+    const bool two = i + 1 < count;
+    double* __restrict x0 = out + i * out_stride;
+    double* __restrict x1 = two ? x0 + out_stride : x0;
+    std::copy(rhs + i * a_, rhs + (i + 1) * a_, x0);
+    if (two) std::copy(rhs + (i + 1) * a_, rhs + (i + 2) * a_, x1);
+    for (std::size_t c = a_; c-- > 0;) {
+      const double* col = u + c;
+      const double b0 = x0[c];
+      if (two) {
+        const double b1 = x1[c];
+        for (std::size_t r = 0; r < c; ++r) {
+          const double v = col[r * ld];
+          x0[r] -= v * b0;
+          x1[r] -= v * b1;
+        }
+      } else {
+        for (std::size_t r = 0; r < c; ++r) x0[r] -= col[r * ld] * b0;
+      }
+    }
   }
 }
 
 void NestedRls::solve_top(std::size_t b0, std::size_t count, const double* beta_b, double* beta_a) const noexcept {
-  // R_AA beta_A = R_Ay - R_AB beta_B.
+  // U_AA beta_A = U_Ay - U_AB beta_B (the rows' weights cancel).
   const auto target = static_cast<Eigen::Index>(cols_ - 1);
   double* rhs = pair_rhs_.col(0).data();
   for (std::size_t r = 0; r < a_; ++r) {
@@ -194,7 +248,7 @@ void NestedRls::solve_top(std::size_t b0, std::size_t count, const double* beta_
     for (std::size_t c = 0; c < count; ++c) v -= row[c] * beta_b[c];
     rhs[r] = v;
   }
-  apply_top_inverse(rhs, beta_a);
+  solve_top_unit(rhs, 1, beta_a, a_);
 }
 
 const Eigen::MatrixXd& NestedRls::solve_pairs_prefix() const noexcept {
@@ -206,10 +260,10 @@ const Eigen::MatrixXd& NestedRls::solve_pairs_prefix() const noexcept {
   // beta_B_i of every pairwise model, each zero-padded to whole lanes.
   for (std::size_t i = 0; i < m_; ++i) {
     double* beta_b = pair_beta_b_.col(static_cast<Eigen::Index>(i)).data();
-    if (i == 0) lower_.solve_prefix_padded(nb_, beta_b);
+    if (i == 0) lower_solve_prefix(nb_, beta_b, true);
     else pairs_[i - 1].solve_prefix_padded(nb_, beta_b);
   }
-  // Right-hand sides R_Ay - R_AB_i beta_B_i, one column each: a dot product
+  // Right-hand sides U_Ay - U_AB_i beta_B_i, one column each: a dot product
   // of whole lanes per row (the lanes past B_i meet beta's zero padding;
   // top_ has a spare block of lanes so the last block stays inside the row),
   // four rows' reductions done together.
@@ -246,44 +300,23 @@ const Eigen::MatrixXd& NestedRls::solve_pairs_prefix() const noexcept {
       default: rhs_column.template operator()<0>(i); break;
     }
   }
-  // pair_prefix = R_AA^-1 rhs = L^T rhs, L = R_AA^-T lower triangular: each
-  // block of lanes of the result sums rows r >= its first column (rows above
-  // are zero there), accumulated in registers, two inputs sharing each load
-  // of L.
+  // pair_prefix = U_AA^-1 rhs, zero past a.
   const std::size_t a_padded = givens::padded(a_);
-  const double* inv = top_inv_.data();
-  const auto inv_ld = static_cast<std::size_t>(top_inv_.cols());
   double* prefix = pair_prefix_.data();
-  for (std::size_t i = 0; i < m_; i += 2) {
-    const bool two = i + 1 < m_;
-    const double* rhs0 = rhs + i * a_;
-    const double* rhs1 = two ? rhs0 + a_ : rhs0;
-    double* out0 = prefix + i * a_padded;
-    for (std::size_t k = 0; k < a_padded; k += kLanes) {
-      Lanes acc0 = {};
-      Lanes acc1 = {};
-      const double* l = inv + k * inv_ld + k;
-      for (std::size_t r = k; r < a_; ++r, l += inv_ld) {
-        const Lanes lr = load(l);
-        acc0 += rhs0[r] * lr;
-        acc1 += rhs1[r] * lr;
-      }
-      givens::store(out0 + k, acc0);
-      if (two) givens::store(out0 + a_padded + k, acc1);
-    }
-  }
+  for (std::size_t i = 0; i < m_; ++i) std::fill(prefix + i * a_padded + a_, prefix + (i + 1) * a_padded, 0.0);
+  solve_top_unit(rhs, m_, prefix, a_padded);
   return pair_prefix_;
 }
 
 void NestedRls::solve_pair_prefix(std::size_t i, Eigen::Ref<Eigen::VectorXd> out) const noexcept {
   auto beta_b = coef_b_.head(static_cast<Eigen::Index>(nb_));
-  if (i == 0) lower_.solve_prefix(nb_, beta_b);
+  if (i == 0) lower_solve_prefix(nb_, beta_b.data(), false);
   else pairs_[i - 1].solve_prefix(nb_, beta_b);
   solve_top(i * nb_, nb_, beta_b.data(), out.data());
 }
 
 void NestedRls::solve_full(Eigen::Ref<Eigen::VectorXd> out) const noexcept {
-  lower_.solve_prefix(m_ * nb_, coef_b_);
+  lower_solve_prefix(m_ * nb_, coef_b_.data(), false);
   solve_top(0, m_ * nb_, coef_b_.data(), out.data());
   std::copy(coef_b_.data(), coef_b_.data() + m_ * nb_, out.data() + a_);
 }

@@ -7,16 +7,22 @@
 // Why it is cheaper than separate factors: in the upper-triangular factor of
 // [A B_1 .. B_m y] the rows of the prefix A, [R_AA R_AB_1 .. R_AB_m R_Ay], are
 // the same in every model that starts with A (they depend only on the Gram
-// matrix's A rows), and so are the Givens rotations that absorb a new sample
+// matrix's A rows), and so are the rotations that absorb a new sample
 // into them. What differs between the models is only the factor of what A
 // leaves unexplained: the Schur complement of [B_1 .. B_m y] (full model) or
 // of [B_i y] (pairwise model i) given A. So one trapezoid of A rows absorbs
 // the sample once, and what the rotations leave of the row, [w_B1 .. w_Bm,
-// w_y], goes on to one lower SqrtRls over [B_1 .. B_m, y] and to one small
-// SqrtRls over [B_i, y] per input i > 1 (the first input's pairwise model is
+// w_y], goes on to one lower factor over [B_1 .. B_m, y] and to one small
+// factor over [B_i, y] per input i > 1 (the first input's pairwise model is
 // a prefix of the full lower factor). Each model's factor is then exactly
-// what a separate SqrtRls of that model would hold; the pairwise models cost
+// what a separate fit of that model would hold; the pairwise models cost
 // O(nb^2) instead of O((na + nb)^2) per sample.
+//
+// Factors: the trapezoid and the lower factors are square-root free (R =
+// D^1/2 U, ud_rls.hpp): what the trapezoid's rotations leave of the row
+// goes on with the weight they leave it. Only a lower factor that tracks
+// its inverse for the Wald tests (track_inverse) is a SqrtRls; it takes the
+// row scaled by the square root of that weight.
 //
 // Priors: the A directions' prior lives in the trapezoid and is kept alive as
 // in SqrtRls (a unit row every K samples, absorbed without forgetting and
@@ -30,6 +36,7 @@
 #include <Eigen/Dense>
 
 #include "core/sqrt_rls.hpp"
+#include "core/ud_rls.hpp"
 
 namespace mpm {
 
@@ -62,9 +69,9 @@ class NestedRls {
   // of the model of the first k <= prefix() regressors of A,
   double rss_head(std::size_t k) const noexcept;
   // of the model of A alone (the paper's Sigma1 times the weight sum),
-  double rss_prefix_only() const noexcept { return lower_.rss_prefix(0); }
+  double rss_prefix_only() const noexcept { return lower_rss_prefix(0); }
   // of the full model,
-  double rss_full() const noexcept { return lower_.rss(); }
+  double rss_full() const noexcept { return wald_ ? lower_wald_.rss() : lower_.rss(); }
   // of the pairwise model [A, B_i] and of its own A-only part (equal to
   // rss_prefix_only() but for the rounding and priors of its own factor),
   double rss_pair(std::size_t i) const noexcept;
@@ -94,40 +101,41 @@ class NestedRls {
   std::size_t m_ = 0;
   std::size_t nb_ = 0;
   std::size_t cols_ = 0;          // a + m nb + 1
-  double sqrt_lambda_ = 1.0;
-  double inv_sqrt_lambda_ = 1.0;
+  double lambda_ = 1.0;
   double delta_ = 1e-9;
   bool forgets_ = false;
+  bool wald_ = false;             // the full lower factor tracks its inverse
   int prior_period_ = 1;
   int since_prior_ = 0;
   double prior_weight_ = 0.0;
   std::size_t next_prior_row_ = 0;
-  Matrix top_;                    // a x (padded cols + lanes): the A rows [R_AA R_AB R_Ay]
-  Matrix top_inv_;                // a x a lower triangular R_AA^-T, carried
-                                  // through the same rotations (sqrt_rls.hpp):
-                                  // the pairwise coefficients without a
-                                  // back substitution's dependency chain
-  Eigen::VectorXd row_inv_;       // its counterpart of row_
-  SqrtRls lower_;                 // [B_1 .. B_m | y] given A
-  std::vector<SqrtRls> pairs_;    // [B_i | y] given A, i = 2..m
+  Matrix top_;                    // a x (padded cols + lanes): the A rows of U, [U_AA U_AB U_Ay]
+  Eigen::VectorXd top_d_;         // their weights (D)
+  UdRls lower_;                   // [B_1 .. B_m | y] given A (unless wald_)
+  SqrtRls lower_wald_;            // the same with its inverse tracked (wald_)
+  std::vector<UdRls> pairs_;      // [B_i | y] given A, i = 2..m
   Eigen::VectorXd row_;           // staged row, cols values
+  double row_weight_ = 1.0;       // its weight after the trapezoid's rotations
   mutable Eigen::VectorXd coef_b_;  // scratch: B coefficients (m nb)
   mutable Eigen::MatrixXd pair_beta_b_;  // padded(nb) x m: beta_B_i, zero padded
-  mutable Eigen::MatrixXd pair_rhs_;     // a x m: R_Ay - R_AB_i beta_B_i
+  mutable Eigen::MatrixXd pair_rhs_;     // a x m: U_Ay - U_AB_i beta_B_i
   mutable Eigen::MatrixXd pair_prefix_;  // padded(a) x m: solve_pairs_prefix's result
 
-  // Rotates row_ through the trapezoid rows [first, a) with `scale`.
-  void absorb_top(std::size_t first, double scale) noexcept;
+  double lower_rss_prefix(std::size_t k) const noexcept {
+    return wald_ ? lower_wald_.rss_prefix(k) : lower_.rss_prefix(k);
+  }
+  void lower_solve_prefix(std::size_t k, double* out, bool padded) const noexcept;
+  // Rotates row_ through the trapezoid rows [first, a), forgetting lambda.
+  void absorb_top(std::size_t first, double lambda) noexcept;
   // Hands what is left of row_ to the lower factors as their staged rows.
   void stage_lowers() noexcept;
-  // Same, absorbed at once with weight 1 (the trapezoid's prior row).
+  // Same, absorbed at once without forgetting (the trapezoid's prior row).
   void add_to_lowers() noexcept;
   void refresh_prior() noexcept;
-  // Rotation i of the trapezoid (and of R_AA^-T) against row_.
-  void rotate_top_row(std::size_t i, double scale) noexcept;
-  // out = R_AA^-1 rhs (a values each).
-  void apply_top_inverse(const double* rhs, double* out) const noexcept;
-  // R_AA beta_A = R_Ay - R_AB beta_B for the B columns [b0, b0 + count).
+  // U_AA beta_A = rhs for `count` right-hand sides (columns of a values,
+  // stride a) into columns of stride out_stride (unit diagonal: no division).
+  void solve_top_unit(const double* rhs, std::size_t count, double* out, std::size_t out_stride) const noexcept;
+  // U_AA beta_A = U_Ay - U_AB beta_B for the B columns [b0, b0 + count).
   void solve_top(std::size_t b0, std::size_t count, const double* beta_b, double* beta_a) const noexcept;
 };
 

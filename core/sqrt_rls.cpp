@@ -312,7 +312,6 @@ double SqrtRls::rss_without(std::size_t first, std::size_t count, Matrix& scratc
   // trapezoidal with `count` extra subdiagonals. Re-triangularised by one
   // Householder reflection per column (one square root per column instead of
   // `count` dependent Givens rotations).
-  constexpr std::size_t kChunk = 64;
   const std::size_t rows = p_ + 1 - first;
   const std::size_t cols = p_ + 1 - first - count;
   for (std::size_t r = 0; r < rows; ++r) {
@@ -320,6 +319,11 @@ double SqrtRls::rss_without(std::size_t first, std::size_t count, Matrix& scratc
     const double* src = r_.row(static_cast<Eigen::Index>(first + r)).data() + first + count;
     for (std::size_t c = 0; c < cols; ++c) dst[c] = src[c];
   }
+  return retriangularised_rss(scratch, rows, cols, count);
+}
+
+double SqrtRls::retriangularised_rss(Matrix& scratch, std::size_t rows, std::size_t cols, std::size_t count) noexcept {
+  constexpr std::size_t kChunk = 64;
   for (std::size_t c = 0; c + 1 < cols; ++c) {
     const std::size_t last_row = std::min(rows - 1, c + count);
     double sigma = 0.0;  // squares below the diagonal

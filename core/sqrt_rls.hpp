@@ -83,6 +83,10 @@ class SqrtRls {
   // Weighted RSS of the model that leaves out regressors [first, first+count).
   // `scratch` must be at least (p+1) x (p+1); it is overwritten. Real-time safe.
   double rss_without(std::size_t first, std::size_t count, Matrix& scratch) const noexcept;
+  // What rss_without does once it has copied the trapezoid: rows x cols of
+  // scratch, upper triangular but for `count` subdiagonals, target column
+  // last; returns the RSS left after re-triangularising it (overwritten).
+  static double retriangularised_rss(Matrix& scratch, std::size_t rows, std::size_t cols, std::size_t count) noexcept;
   // The same by the Wald identity from the tracked inverse factor (requires
   // tracks_inverse(); otherwise falls back to rss_without). Same scratch.
   double rss_without_wald(std::size_t first, std::size_t count, Matrix& scratch) const noexcept;

@@ -1,95 +1,21 @@
-// Square-root RLS against an independent batch least-squares reference
-// (Householder QR over the stacked data), with and without forgetting.
+// Square-root RLS: what only it does (the tracked inverse, the Wald tests,
+// the one-pass update of large factors) against re-triangularisation and
+// batch least squares. What every factor does: test_rls_factors.cpp.
 #include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
 
 #include "core/sqrt_rls.hpp"
+#include "support/batch_qr.hpp"
 
 namespace mpm {
 namespace {
 
-constexpr double kDelta = 1e-9;
-
-// Batch reference: accumulates the R factor of [sqrt(w) X, sqrt(w) y] with
-// Householder QR over blocks (TSQR), plus the prior rows sqrt(delta) I.
-class BatchQr {
- public:
-  explicit BatchQr(int p) : p_(p), r_(Eigen::MatrixXd::Zero(p + 1, p + 1)) {
-    for (int i = 0; i < p; ++i) r_(i, i) = std::sqrt(kDelta);
-  }
-  void add_block(const Eigen::MatrixXd& rows) {  // rows: n x (p+1)
-    Eigen::MatrixXd stacked(r_.rows() + rows.rows(), p_ + 1);
-    stacked << r_, rows;
-    Eigen::HouseholderQR<Eigen::MatrixXd> qr(stacked);
-    r_ = qr.matrixQR().topRows(p_ + 1).triangularView<Eigen::Upper>();
-  }
-  // RSS of the LS fit on the regressor columns `keep` (indices < p).
-  double rss(const std::vector<int>& keep) const {
-    if (keep.empty()) return r_.col(p_).squaredNorm();
-    Eigen::MatrixXd x(r_.rows(), static_cast<Eigen::Index>(keep.size()));
-    for (std::size_t c = 0; c < keep.size(); ++c) x.col(static_cast<Eigen::Index>(c)) = r_.col(keep[c]);
-    const Eigen::VectorXd y = r_.col(p_);
-    const Eigen::VectorXd beta = x.colPivHouseholderQr().solve(y);
-    return (y - x * beta).squaredNorm();
-  }
-  Eigen::VectorXd beta() const {
-    return r_.topLeftCorner(p_, p_).triangularView<Eigen::Upper>().solve(r_.col(p_).head(p_));
-  }
-
- private:
-  int p_;
-  Eigen::MatrixXd r_;
-};
-
-// ARX-like data: regressors correlated with each other and with y.
-struct DataGen {
-  std::mt19937_64 rng{42};
-  std::normal_distribution<double> n{0.0, 1.0};
-  Eigen::VectorXd state;
-  explicit DataGen(int p) : state(Eigen::VectorXd::Zero(p)) {}
-  void next(Eigen::Ref<Eigen::VectorXd> x, double& y) {
-    for (Eigen::Index i = 0; i < state.size(); ++i) state[i] = 0.7 * state[i] + n(rng) + (i > 0 ? 0.3 * state[i - 1] : 0.0);
-    x = state;
-    x[0] = 1.0;  // intercept
-    y = 0.5 + 0.8 * x[1] - 0.3 * x[x.size() - 1] + n(rng);
-  }
-};
-
-std::vector<int> range_except(int p, int first, int count) {
-  std::vector<int> v;
-  for (int i = 0; i < p; ++i)
-    if (i < first || i >= first + count) v.push_back(i);
-  return v;
-}
-
-TEST(SqrtRls, EqualsBatchAfterAMillionSamples) {
-  const int p = 7;
-  SqrtRls rls(p, 1.0, kDelta);
-  BatchQr batch(p);
-  DataGen gen(p);
-  const int n = 1'000'000, block = 20'000;
-  Eigen::MatrixXd rows(block, p + 1);
-  Eigen::VectorXd x(p);
-  double y = 0;
-  for (int k = 0; k < n; ++k) {
-    gen.next(x, y);
-    rls.update(x.data(), y);
-    rows.row(k % block).head(p) = x.transpose();
-    rows(k % block, p) = y;
-    if ((k + 1) % block == 0) batch.add_block(rows);
-  }
-  const auto rel = [](double a, double b) { return std::abs(a - b) / std::abs(b); };
-  EXPECT_LT(rel(rls.rss(), batch.rss(range_except(p, p, 0))), 1e-8);
-  for (int k = 1; k <= p; ++k) EXPECT_LT(rel(rls.rss_prefix(static_cast<std::size_t>(k)), batch.rss(range_except(k, k, 0))), 1e-8) << k;
-  SqrtRls::Matrix scratch(p + 1, p + 1);
-  EXPECT_LT(rel(rls.rss_without(2, 3, scratch), batch.rss(range_except(p, 2, 3))), 1e-8);
-  Eigen::VectorXd beta(p);
-  rls.solve_prefix(p, beta);
-  const Eigen::VectorXd ref = batch.beta();
-  EXPECT_LT((beta - ref).norm() / ref.norm(), 1e-8);
-}
+using test::BatchQr;
+using test::DataGen;
+using test::kDelta;
+using test::range_except;
 
 TEST(SqrtRls, RssWithoutEveryBlockMatchesBatchOnSubsets) {
   const int p = 12;
@@ -113,49 +39,6 @@ TEST(SqrtRls, RssWithoutEveryBlockMatchesBatchOnSubsets) {
       EXPECT_NEAR(rls.rss_without(static_cast<std::size_t>(first), static_cast<std::size_t>(count), scratch) / ref, 1.0, 1e-10)
           << first << "+" << count;
     }
-}
-
-TEST(SqrtRls, ForgettingEqualsWeightedBatch) {
-  const int p = 5;
-  const double lambda = 0.99;
-  SqrtRls rls(p, lambda, kDelta);
-  DataGen gen(p);
-  const int n = 2000;
-  Eigen::MatrixXd rows(n, p + 1);
-  Eigen::VectorXd x(p);
-  double y = 0;
-  for (int k = 0; k < n; ++k) {
-    gen.next(x, y);
-    rls.update(x.data(), y);
-    rows.row(k).head(p) = x.transpose();
-    rows(k, p) = y;
-  }
-  for (int k = 0; k < n; ++k) rows.row(k) *= std::sqrt(std::pow(lambda, n - 1 - k));
-  BatchQr batch(p);  // its prior is ~delta (the kept-alive prior is of the same size)
-  batch.add_block(rows);
-  EXPECT_NEAR(rls.rss() / batch.rss(range_except(p, p, 0)), 1.0, 1e-9);
-  EXPECT_NEAR(rls.rss_prefix(2) / batch.rss(range_except(2, 2, 0)), 1.0, 1e-9);
-}
-
-TEST(SqrtRls, StaysBoundedWithoutExcitation) {
-  // Inputs constant for 10^4 samples with forgetting: the information in the
-  // unexcited directions decays; the kept-alive prior must hold it up so that
-  // the covariance (R^T R)^-1 stays finite and bounded.
-  const int p = 6;
-  SqrtRls rls(p, 0.98, 1e-6);
-  Eigen::VectorXd x = Eigen::VectorXd::Constant(p, 2.0);
-  x[0] = 1.0;
-  for (int k = 0; k < 10'000; ++k) rls.update(x.data(), 1.0 + 1e-3 * std::sin(k));
-  const auto& r = rls.factor();
-  const Eigen::MatrixXd rp = r.topLeftCorner(p, p);
-  const Eigen::MatrixXd info = rp.transpose() * rp;
-  ASSERT_TRUE(info.allFinite());
-  const Eigen::VectorXd eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(info).eigenvalues();
-  EXPECT_GT(eig.minCoeff(), 0.3e-6);  // covariance <= ~1/delta
-  Eigen::VectorXd beta(p);
-  rls.solve_prefix(p, beta);
-  EXPECT_TRUE(beta.allFinite());
-  EXPECT_TRUE(std::isfinite(rls.rss()));
 }
 
 // The Wald identity on the tracked inverse equals re-triangularisation for
