@@ -107,6 +107,34 @@ double ud_solve_prefix_flops(std::size_t k) {
   return f;
 }
 
+double bierman_update_flops(std::size_t p, std::size_t block, double lambda) {
+  // absorb(): the a priori error (2p); per column j of U (padded(j) rows):
+  // the dot product with h (2 each), f, g, alpha (4), the new d (3), p_j (1),
+  // the column and gain update (4 each); the gain step k (1), beta += gain k
+  // (2p), the RSS (3) and the target's energy (4); the block covariances'
+  // downdates (per row 1, per lower-triangle entry 3).
+  const auto absorb = [&] {
+    double f = 2.0 * d(p) + 1.0 + 2.0 * d(p) + 3.0 + 4.0 + 1.0;
+    for (std::size_t j = 0; j < p; ++j) f += 6.0 * d(givens::padded(j)) + 8.0;
+    for (std::size_t r = 0; r < block; ++r) f += d(p / block) * (1.0 + 3.0 * d(r + 1));
+    return f;
+  };
+  double f = absorb();
+  // One block's covariance from U and D per sample, averaged over the
+  // round robin: per column k >= b0, per stored row a its (a + 1) entries
+  // (1 + 2 (a + 1)), and the diagonal's row inside the block.
+  double resync = 0.0;
+  for (std::size_t b0 = 0; b0 < p; b0 += block)
+    for (std::size_t k = b0; k < p; ++k) {
+      const std::size_t stored = std::min(block, k - b0);
+      for (std::size_t a = 0; a < stored; ++a) resync += 1.0 + 2.0 * d(a + 1);
+      if (stored < block) resync += 2.0 * d(stored) + 1.0;
+    }
+  f += resync / d(p / block);
+  if (lambda < 1.0) f += absorb() / static_cast<double>(prior_refresh_period(p, lambda));
+  return f;
+}
+
 double rss_without_flops(std::size_t p, std::size_t first, std::size_t count) {
   const std::size_t n = p + 1;
   if (count == 0) return rss_prefix_flops(p, p);
@@ -207,28 +235,29 @@ namespace {
 double statistics_flops(std::size_t inputs, std::size_t na, std::size_t nb, bool gamma, bool wald) {
   const std::size_t a = 1 + na;
   const std::size_t p_lower = inputs * nb;
-  const auto lower_rss_prefix = [&](std::size_t k) {
-    return wald ? rss_prefix_flops(p_lower, k) : ud_rss_prefix_flops(p_lower, k);
-  };
+  // The lower factor's RSS values: prefix sums of a UdRls, or tracked
+  // (free) in the covariance form.
+  const auto lower_rss_prefix = [&](std::size_t k) { return wald ? 0.0 : ud_rss_prefix_flops(p_lower, k); };
   // rss_full, rss_prefix_only, rss_head(1) (rss_prefix_only again plus the
   // a - 1 trapezoid rows' d z^2, 3 each); three divisions by sum_w;
   // lr_joint: division, log, product; gamma_lambda^2.
   double f = lower_rss_prefix(p_lower) + 2.0 * lower_rss_prefix(0) + 3.0 * d(a - 1) + 1.0 + 3.0 + 3.0 + 1.0;
   for (std::size_t i = 0; i < inputs; ++i) {
     f += 3.0;  // f_conditional (division, log), lr_conditional
-    // Pairwise F: its A-only RSS and its RSS (input 0: prefix sums of the
-    // lower factor; else the pairwise UdRls's), division, log, product.
-    f += i == 0 ? lower_rss_prefix(0) + lower_rss_prefix(nb) : ud_rss_prefix_flops(nb, 0) + ud_rss_prefix_flops(nb, nb);
+    // Pairwise F: its A-only RSS and its RSS (input 0 without the covariance
+    // form: prefix sums of the lower factor; else the pairwise UdRls's),
+    // division, log, product.
+    f += i == 0 && !wald ? lower_rss_prefix(0) + lower_rss_prefix(nb)
+                         : ud_rss_prefix_flops(nb, 0) + ud_rss_prefix_flops(nb, nb);
     f += 3.0;
     if (gamma) {
       // solve_pairs_prefix, this input's share: nb coefficients of its block
-      // (back substitution), the trapezoid's right-hand side (a rows of nb
-      // multiply-subtracts) and the back substitution with the unit U_AA
+      // (unit back substitution), the trapezoid's right-hand side (a rows of
+      // nb multiply-subtracts) and the back substitution with the unit U_AA
       // (a (a - 1) / 2 multiply-subtracts); |g_hat - g_N|^2: na
       // subtractions, na products, na - 1 adds; 1 + |g_N|^2: 2 na; the
       // quotient: 1.
-      f += (i == 0 && wald ? solve_prefix_flops(nb) : ud_solve_prefix_flops(nb)) + 2.0 * d(a) * d(nb) +
-           d(a) * d(a - 1);
+      f += ud_solve_prefix_flops(nb) + 2.0 * d(a) * d(nb) + d(a) * d(a - 1);
       f += 3.0 * d(na) - 1.0 + 2.0 * d(na) + 1.0;
     }
   }
@@ -262,34 +291,31 @@ MonitorFlops monitor_flops(std::size_t inputs, std::size_t outputs, const Monito
   // (from a round-robin row r) passed on to the lower and pairwise factors.
   double shared = 0.0;
   for (std::size_t i = 0; i < a; ++i) shared += ud_rotation_flops(cols - 1 - i);
-  if (wald) {
-    shared += 1.0 + d(p_lower + 1) + sqrt_rls_update_flops(p_lower, lambda, true);
-    shared += tracked_blocks_update_flops(p_lower, nb, lambda);
-  } else {
-    shared += ud_rls_update_flops(p_lower, lambda);
-  }
+  shared += wald ? bierman_update_flops(p_lower, nb, lambda) : ud_rls_update_flops(p_lower, lambda);
   if (lambda < 1.0) {
     double prior = 0.0;
     for (std::size_t r = 0; r < a; ++r)
       for (std::size_t i = r; i < a; ++i) prior += ud_rotation_flops(cols - 1 - i);
     prior /= d(a);
-    prior += wald ? 1.0 + d(p_lower + 1) + absorb_flops(0, p_lower, true, true) : ud_absorb_flops(0, p_lower);
-    prior += d(inputs - 1) * ud_absorb_flops(0, nb);
+    // Passed on: the covariance form's absorb() without its resync, counted
+    // as a whole update (an upper bound by the resync's share); or UdRls's.
+    prior += wald ? bierman_update_flops(p_lower, nb, 1.0) : ud_absorb_flops(0, p_lower);
+    prior += d(wald ? inputs : inputs - 1) * ud_absorb_flops(0, nb);
     shared += prior / static_cast<double>(prior_refresh_period(a, lambda));
   }
   f.full_updates = n_out * shared;
-  f.pairwise_updates = n_out * d(inputs - 1) * ud_rls_update_flops(nb, lambda);
+  f.pairwise_updates = n_out * d(wald ? inputs : inputs - 1) * ud_rls_update_flops(nb, lambda);
   // rss_without_block: one input, the prefix-only RSS; two, a pairwise RSS
-  // or a prefix sum; more, rss_without_wald on the lower factor (which falls
-  // back to rss_without without the inverse, except for the trailing block).
+  // or a prefix sum; more, re-triangularisation of the UdRls lower factor
+  // (a prefix sum for the trailing block) or, in covariance form, the Wald
+  // quadratic of the block's tracked covariance and coefficients.
   double conditional = 0.0;
   for (std::size_t i = 0; i < inputs; ++i) {
     const std::size_t first = i * nb;
     if (inputs == 1) conditional += ud_rss_prefix_flops(p_lower, 0);
     else if (inputs == 2) conditional += i == 0 ? ud_rss_prefix_flops(nb, nb) : ud_rss_prefix_flops(p_lower, nb);
-    else if (!wald) conditional += ud_rss_without_flops(p_lower, first, nb);  // trailing block: a prefix sum
-    else if (first + nb >= p_lower) conditional += rss_without_wald_flops(p_lower, first, nb);
-    else conditional += tracked_block_wald_flops(p_lower, nb);
+    else if (!wald) conditional += ud_rss_without_flops(p_lower, first, nb);
+    else conditional += wald_quadratic_flops(nb) + 1.0;
   }
   f.conditional = n_out * conditional;
   // absorb_sample's weights (sum_w 2, sum_w2 3, n_eq 2) and update_statistics'

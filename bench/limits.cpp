@@ -37,12 +37,16 @@ double state_bytes_per_update(std::size_t inputs, std::size_t outputs, const Mon
   const std::size_t p = inputs * nb;                   // lower factor's regressors
   const std::size_t cols = givens::padded(a + p + 1);  // the shared rows' width
   double per_output = 8.0 * d(a) * (d(cols) + 1.0);    // [U_AA U_AB U_Ay] and D
-  per_output += triangle_bytes(p + 1);                 // lower factor
-  if (inputs >= kWaldMinInputs) {
-    per_output += triangle_bytes(p);                   // its inverse
+  const bool wald = inputs >= kWaldMinInputs;
+  if (wald) {                                          // lower factor in covariance form:
+    double columns = 0.0;                              // U's columns above the diagonal,
+    for (std::size_t j = 0; j < p; ++j) columns += d(givens::padded(j));
+    per_output += 8.0 * (columns + d(p));              // D,
     per_output += 8.0 * d(p) * d(nb);                  // block covariances
+  } else {
+    per_output += triangle_bytes(p + 1);               // lower factor [U | z] (D is p values more)
   }
-  per_output += d(inputs - 1) * triangle_bytes(nb + 1);  // pairwise factors
+  per_output += d(wald ? inputs : inputs - 1) * triangle_bytes(nb + 1);  // pairwise factors
   return d(outputs) * per_output;
 }
 

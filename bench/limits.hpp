@@ -19,9 +19,10 @@ namespace mpm::bench {
 // Bytes of factor state one used sample reads (and writes back) in a
 // monitor of `inputs` x `outputs` with these settings: for each output the
 // shared rows of [1, AR] and their weights, the lower factor of the inputs'
-// regressors (with its inverse and block covariances from 4 inputs on, as
-// the core does), and the pairwise factors; triangles where the core only
-// touches triangles. Mirrors core/nested_rls.cpp, core/ud_rls.cpp and core/sqrt_rls.cpp.
+// regressors (in covariance form, with its block covariances, from 4 inputs
+// on, as the core does), and the pairwise factors; triangles where the core
+// only touches triangles. Mirrors core/nested_rls.cpp, core/ud_rls.cpp and
+// core/bierman_rls.cpp.
 double state_bytes_per_update(std::size_t inputs, std::size_t outputs, const MonitorSettings& settings);
 
 // Dependent rotations on one output's longest chain: the rows of

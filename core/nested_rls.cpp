@@ -9,7 +9,7 @@
 namespace mpm {
 namespace {
 
-// Lower factors updated together (SqrtRls::update_staged): enough
+// Lower factors updated together (UdRls::update_staged): enough
 // independent rotation chains to hide the divisions' latency.
 constexpr std::size_t kLockstep = 8;
 // Factors with more regressors than this are updated alone: their rows are
@@ -21,7 +21,7 @@ constexpr std::size_t kLockstepMaxRegressors = 64;
 }  // namespace
 
 NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_size, double forgetting,
-                     double regularization, bool track_inverse)
+                     double regularization, bool wald_tests)
     : a_(prefix),
       m_(blocks),
       nb_(block_size),
@@ -29,7 +29,7 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
       lambda_(forgetting),
       delta_(regularization),
       forgets_(forgetting < 1.0),
-      wald_(track_inverse) {
+      wald_(wald_tests) {
   if (prefix == 0 || blocks == 0 || block_size == 0)
     throw std::invalid_argument("NestedRls: need a prefix and at least one block of regressors");
   if (!(forgetting > 0.0 && forgetting <= 1.0)) throw std::invalid_argument("NestedRls: forgetting must be in (0, 1]");
@@ -40,9 +40,9 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
   // reads of a block of B columns may run past the last one.
   top_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(givens::padded(cols_) + givens::kLanes));
   top_d_.resize(static_cast<Eigen::Index>(a_));
-  if (wald_) lower_wald_ = SqrtRls(m_ * nb_, forgetting, regularization, true, nb_);
+  if (wald_) lower_wald_ = BiermanRls(m_ * nb_, nb_, forgetting, regularization);
   else lower_ = UdRls(m_ * nb_, forgetting, regularization);
-  pairs_.assign(m_ - 1, UdRls(nb_, forgetting, regularization));
+  pairs_.assign(wald_ ? m_ : m_ - 1, UdRls(nb_, forgetting, regularization));
   row_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(givens::padded(cols_)));
   pair_rhs_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(m_));
   coef_b_.resize(static_cast<Eigen::Index>(m_ * nb_));
@@ -73,16 +73,15 @@ void NestedRls::stage_lowers() noexcept {
   const double* w = row_.data();
   const double y = w[cols_ - 1];
   if (wald_) {
-    // A SqrtRls takes rows of weight 1: the row scaled by sqrt(weight).
-    const double scale = std::sqrt(row_weight_);
-    double* q = lower_wald_.staged_row();
-    for (std::size_t c = a_; c < cols_; ++c) q[c - a_] = scale * w[c];
+    std::copy(w + a_, w + cols_, lower_wald_.staged_row());  // B_1 .. B_m, y
+    lower_wald_.stage_weight(row_weight_);
   } else {
-    std::copy(w + a_, w + cols_, lower_.staged_row());  // B_1 .. B_m, y
+    std::copy(w + a_, w + cols_, lower_.staged_row());
     lower_.stage_weight(row_weight_);
   }
-  for (std::size_t i = 1; i < m_; ++i) {
-    UdRls& pair = pairs_[i - 1];
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    const std::size_t i = wald_ ? k : k + 1;  // the input of pairs_[k]
+    UdRls& pair = pairs_[k];
     double* q = pair.staged_row();
     std::copy(w + a_ + i * nb_, w + a_ + (i + 1) * nb_, q);
     q[nb_] = y;
@@ -93,15 +92,12 @@ void NestedRls::stage_lowers() noexcept {
 void NestedRls::add_to_lowers() noexcept {
   const double* w = row_.data();
   const double y = w[cols_ - 1];
-  if (wald_) {
-    const double scale = std::sqrt(row_weight_);
-    double* q = lower_wald_.staged_row();  // free between updates: add_row copies from it
-    for (std::size_t c = a_; c < cols_; ++c) q[c - a_] = scale * w[c];
-    lower_wald_.add_row(q, q[cols_ - 1 - a_]);
-  } else {
-    lower_.add_row(w + a_, y, row_weight_);
+  if (wald_) lower_wald_.add_row(w + a_, y, row_weight_);
+  else lower_.add_row(w + a_, y, row_weight_);
+  for (std::size_t k = 0; k < pairs_.size(); ++k) {
+    const std::size_t i = wald_ ? k : k + 1;
+    pairs_[k].add_row(w + a_ + i * nb_, y, row_weight_);
   }
-  for (std::size_t i = 1; i < m_; ++i) pairs_[i - 1].add_row(w + a_ + i * nb_, y, row_weight_);
 }
 
 void NestedRls::update(const double* x, double y) noexcept {
@@ -125,39 +121,30 @@ void NestedRls::update_staged(NestedRls* models, std::size_t count) noexcept {
         givens::rotate_sqrt_free(n.top_.row(static_cast<Eigen::Index>(i)).data(), n.top_d_[static_cast<Eigen::Index>(i)],
                                  n.row_.data(), n.row_weight_, i, givens::padded(n.cols_), n.lambda_);
     }
-  // Then every lower factor, a few at a time.
+  // Then every lower factor: the small ones a few at a time, a covariance-
+  // form one alone (its one pass over its columns has latency to spare).
   UdRls* group[kLockstep];
   std::size_t in_group = 0;
-  SqrtRls* wald_group[kLockstep];
-  std::size_t in_wald_group = 0;
   const auto add = [&](UdRls& lower) {
+    if (lower.n_regressors() > kLockstepMaxRegressors) {
+      UdRls* alone = &lower;
+      UdRls::update_staged(&alone, 1);
+      return;
+    }
     group[in_group++] = &lower;
     if (in_group == kLockstep) {
       UdRls::update_staged(group, in_group);
       in_group = 0;
     }
   };
-  const auto add_wald = [&](SqrtRls& lower) {
-    if (lower.n_regressors() > kLockstepMaxRegressors) {
-      SqrtRls* alone = &lower;
-      SqrtRls::update_staged(&alone, 1);
-      return;
-    }
-    wald_group[in_wald_group++] = &lower;
-    if (in_wald_group == kLockstep) {
-      SqrtRls::update_staged(wald_group, in_wald_group);
-      in_wald_group = 0;
-    }
-  };
   for (std::size_t k = 0; k < count; ++k) {
     NestedRls& n = models[k];
     n.stage_lowers();
-    if (n.wald_) add_wald(n.lower_wald_);
+    if (n.wald_) n.lower_wald_.update_staged();
     else add(n.lower_);
     for (UdRls& p : n.pairs_) add(p);
   }
   if (in_group > 0) UdRls::update_staged(group, in_group);
-  if (in_wald_group > 0) SqrtRls::update_staged(wald_group, in_wald_group);
   for (std::size_t k = 0; k < count; ++k) models[k].refresh_prior();
 }
 
@@ -185,28 +172,18 @@ double NestedRls::rss_head(std::size_t k) const noexcept {
 }
 
 double NestedRls::rss_pair(std::size_t i) const noexcept {
-  return i == 0 ? lower_rss_prefix(nb_) : pairs_[i - 1].rss();
+  return i == 0 && !wald_ ? lower_.rss_prefix(nb_) : pair(i).rss();
 }
 
 double NestedRls::rss_pair_prefix_only(std::size_t i) const noexcept {
-  return i == 0 ? lower_rss_prefix(0) : pairs_[i - 1].rss_prefix(0);
+  return i == 0 && !wald_ ? lower_.rss_prefix(0) : pair(i).rss_prefix(0);
 }
 
 double NestedRls::rss_without_block(std::size_t i, Matrix& scratch) const noexcept {
   if (m_ == 1) return rss_prefix_only();
   // Two inputs: the model without one is the pairwise model of the other.
-  if (m_ == 2) return i == 0 ? pairs_[0].rss() : lower_rss_prefix(nb_);
-  return wald_ ? lower_wald_.rss_without_wald(i * nb_, nb_, scratch) : lower_.rss_without(i * nb_, nb_, scratch);
-}
-
-void NestedRls::lower_solve_prefix(std::size_t k, double* out, bool padded) const noexcept {
-  if (wald_) {
-    if (padded) lower_wald_.solve_prefix_padded(k, out);
-    else lower_wald_.solve_prefix(k, Eigen::Map<Eigen::VectorXd>(out, static_cast<Eigen::Index>(k)));
-  } else {
-    if (padded) lower_.solve_prefix_padded(k, out);
-    else lower_.solve_prefix(k, Eigen::Map<Eigen::VectorXd>(out, static_cast<Eigen::Index>(k)));
-  }
+  if (m_ == 2) return rss_pair(1 - i);
+  return wald_ ? lower_wald_.rss_without_block(i, scratch) : lower_.rss_without(i * nb_, nb_, scratch);
 }
 
 void NestedRls::solve_top_unit(const double* rhs, std::size_t count, double* out, std::size_t out_stride) const noexcept {
@@ -260,8 +237,8 @@ const Eigen::MatrixXd& NestedRls::solve_pairs_prefix() const noexcept {
   // beta_B_i of every pairwise model, each zero-padded to whole lanes.
   for (std::size_t i = 0; i < m_; ++i) {
     double* beta_b = pair_beta_b_.col(static_cast<Eigen::Index>(i)).data();
-    if (i == 0) lower_solve_prefix(nb_, beta_b, true);
-    else pairs_[i - 1].solve_prefix_padded(nb_, beta_b);
+    if (i == 0 && !wald_) lower_.solve_prefix_padded(nb_, beta_b);
+    else pair(i).solve_prefix_padded(nb_, beta_b);
   }
   // Right-hand sides U_Ay - U_AB_i beta_B_i, one column each: a dot product
   // of whole lanes per row (the lanes past B_i meet beta's zero padding;
@@ -310,13 +287,14 @@ const Eigen::MatrixXd& NestedRls::solve_pairs_prefix() const noexcept {
 
 void NestedRls::solve_pair_prefix(std::size_t i, Eigen::Ref<Eigen::VectorXd> out) const noexcept {
   auto beta_b = coef_b_.head(static_cast<Eigen::Index>(nb_));
-  if (i == 0) lower_solve_prefix(nb_, beta_b.data(), false);
-  else pairs_[i - 1].solve_prefix(nb_, beta_b);
+  if (i == 0 && !wald_) lower_.solve_prefix(nb_, beta_b);
+  else pair(i).solve_prefix(nb_, beta_b);
   solve_top(i * nb_, nb_, beta_b.data(), out.data());
 }
 
 void NestedRls::solve_full(Eigen::Ref<Eigen::VectorXd> out) const noexcept {
-  lower_solve_prefix(m_ * nb_, coef_b_.data(), false);
+  if (wald_) coef_b_ = lower_wald_.coefficients();
+  else lower_.solve_prefix(m_ * nb_, coef_b_);
   solve_top(0, m_ * nb_, coef_b_.data(), out.data());
   std::copy(coef_b_.data(), coef_b_.data() + m_ * nb_, out.data() + a_);
 }

@@ -20,9 +20,10 @@
 //
 // Factors: the trapezoid and the lower factors are square-root free (R =
 // D^1/2 U, ud_rls.hpp): what the trapezoid's rotations leave of the row
-// goes on with the weight they leave it. Only a lower factor that tracks
-// its inverse for the Wald tests (track_inverse) is a SqrtRls; it takes the
-// row scaled by the square root of that weight.
+// goes on with the weight they leave it. With wald_tests, the full lower
+// factor is kept in covariance form instead (bierman_rls.hpp), which gives
+// every block's conditional RSS by the Wald identity; it has no prefix
+// models, so the first input's pairwise model gets a factor of its own too.
 //
 // Priors: the A directions' prior lives in the trapezoid and is kept alive as
 // in SqrtRls (a unit row every K samples, absorbed without forgetting and
@@ -35,6 +36,7 @@
 
 #include <Eigen/Dense>
 
+#include "core/bierman_rls.hpp"
 #include "core/sqrt_rls.hpp"
 #include "core/ud_rls.hpp"
 
@@ -46,10 +48,11 @@ class NestedRls {
 
   NestedRls() = default;
   // prefix = |A| >= 1, blocks = m >= 1, block_size = |B_i| >= 1, forgetting
-  // in (0, 1], regularization > 0. track_inverse: the full lower factor also
-  // carries its inverse, for rss_without_block by the Wald identity.
+  // in (0, 1], regularization > 0. wald_tests: the full lower factor in
+  // covariance form, for rss_without_block by the Wald identity (m nb must
+  // then be whole blocks of nb, as it is).
   NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_size, double forgetting,
-            double regularization = 1e-9, bool track_inverse = false);
+            double regularization = 1e-9, bool wald_tests = false);
 
   std::size_t prefix() const noexcept { return a_; }
   std::size_t blocks() const noexcept { return m_; }
@@ -69,7 +72,7 @@ class NestedRls {
   // of the model of the first k <= prefix() regressors of A,
   double rss_head(std::size_t k) const noexcept;
   // of the model of A alone (the paper's Sigma1 times the weight sum),
-  double rss_prefix_only() const noexcept { return lower_rss_prefix(0); }
+  double rss_prefix_only() const noexcept { return wald_ ? lower_wald_.rss_empty() : lower_.rss_prefix(0); }
   // of the full model,
   double rss_full() const noexcept { return wald_ ? lower_wald_.rss() : lower_.rss(); }
   // of the pairwise model [A, B_i] and of its own A-only part (equal to
@@ -104,7 +107,7 @@ class NestedRls {
   double lambda_ = 1.0;
   double delta_ = 1e-9;
   bool forgets_ = false;
-  bool wald_ = false;             // the full lower factor tracks its inverse
+  bool wald_ = false;             // the full lower factor in covariance form
   int prior_period_ = 1;
   int since_prior_ = 0;
   double prior_weight_ = 0.0;
@@ -112,8 +115,8 @@ class NestedRls {
   Matrix top_;                    // a x (padded cols + lanes): the A rows of U, [U_AA U_AB U_Ay]
   Eigen::VectorXd top_d_;         // their weights (D)
   UdRls lower_;                   // [B_1 .. B_m | y] given A (unless wald_)
-  SqrtRls lower_wald_;            // the same with its inverse tracked (wald_)
-  std::vector<UdRls> pairs_;      // [B_i | y] given A, i = 2..m
+  BiermanRls lower_wald_;         // the same in covariance form (wald_)
+  std::vector<UdRls> pairs_;      // [B_i | y] given A, i = 2..m (i = 1..m with wald_)
   Eigen::VectorXd row_;           // staged row, cols values
   double row_weight_ = 1.0;       // its weight after the trapezoid's rotations
   mutable Eigen::VectorXd coef_b_;  // scratch: B coefficients (m nb)
@@ -121,10 +124,8 @@ class NestedRls {
   mutable Eigen::MatrixXd pair_rhs_;     // a x m: U_Ay - U_AB_i beta_B_i
   mutable Eigen::MatrixXd pair_prefix_;  // padded(a) x m: solve_pairs_prefix's result
 
-  double lower_rss_prefix(std::size_t k) const noexcept {
-    return wald_ ? lower_wald_.rss_prefix(k) : lower_.rss_prefix(k);
-  }
-  void lower_solve_prefix(std::size_t k, double* out, bool padded) const noexcept;
+  // The pairwise factor of input i >= 1 (i >= 0 with wald_).
+  const UdRls& pair(std::size_t i) const noexcept { return pairs_[wald_ ? i : i - 1]; }
   // Rotates row_ through the trapezoid rows [first, a), forgetting lambda.
   void absorb_top(std::size_t first, double lambda) noexcept;
   // Hands what is left of row_ to the lower factors as their staged rows.

@@ -87,6 +87,9 @@ class SqrtRls {
   // scratch, upper triangular but for `count` subdiagonals, target column
   // last; returns the RSS left after re-triangularising it (overwritten).
   static double retriangularised_rss(Matrix& scratch, std::size_t rows, std::size_t cols, std::size_t count) noexcept;
+  // g^T S^-1 g from scratch (S lower triangle in rows [0, count), g in row
+  // count); -1 if S is not positive definite. Overwrites scratch.
+  static double wald_quadratic(Matrix& scratch, std::size_t count) noexcept;
   // The same by the Wald identity from the tracked inverse factor (requires
   // tracks_inverse(); otherwise falls back to rss_without). Same scratch.
   double rss_without_wald(std::size_t first, std::size_t count, Matrix& scratch) const noexcept;
@@ -140,9 +143,6 @@ class SqrtRls {
   void resync_block_covariance(std::size_t b0) noexcept;
   // L^T z, cached until the factor changes.
   const double* coefficients_from_inverse() const noexcept;
-  // g^T S^-1 g from scratch (S lower triangle, g in row count); -1 if S is
-  // not positive definite.
-  static double wald_quadratic(Matrix& scratch, std::size_t count) noexcept;
 
   std::size_t wald_block_ = 0;
   Matrix block_cov_;               // p x wald_block: block b's S in rows of b

@@ -70,9 +70,9 @@ bool close(double value, double reference, double tol) {
   return std::abs(value - reference) <= tol * std::abs(reference) + 1e-12;
 }
 
-void expect_equal_to_separate_fits(std::size_t m, double lambda, int samples, double tol, bool track_inverse) {
+void expect_equal_to_separate_fits(std::size_t m, double lambda, int samples, double tol, bool wald_tests) {
   const std::size_t a = 4, nb = 3, p = a + m * nb;
-  NestedRls nested(a, m, nb, lambda, kDelta, track_inverse);
+  NestedRls nested(a, m, nb, lambda, kDelta, wald_tests);
   SeparateFits separate(a, m, nb, lambda);
   Rows rows(a, m, nb);
   std::vector<double> x;
@@ -115,7 +115,7 @@ TEST(NestedRls, EqualsSeparateFitsWithoutForgetting) {
   expect_equal_to_separate_fits(1, 1.0, 3000, 1e-9, false);
   expect_equal_to_separate_fits(2, 1.0, 3000, 1e-9, false);  // conditional RSS from the pairwise model
   expect_equal_to_separate_fits(3, 1.0, 3000, 1e-9, false);  // re-triangularisation
-  expect_equal_to_separate_fits(5, 1.0, 3000, 1e-9, true);   // Wald identity
+  expect_equal_to_separate_fits(5, 1.0, 3000, 1e-9, true);   // Wald identity (covariance form)
 }
 
 TEST(NestedRls, EqualsSeparateFitsWithForgetting) {
