@@ -24,22 +24,11 @@ double d(std::size_t n) { return static_cast<double>(n); }
 // after `first`. The scale's products are done even when scale = 1.
 double rotation_flops(std::size_t tail) { return 13.0 + 6.0 * d(tail); }
 
-// rotate_inverse on columns [0, width): c / scale and s / scale as products
-// (2), then 6 per column; `inverse_division` when the scale's reciprocal is
-// not the cached 1 / sqrt(lambda) (the prior row, scale 1: 1.0 / scale).
-double inverse_rotation_flops(std::size_t width, bool inverse_division) {
-  return 2.0 + 6.0 * d(width) + (inverse_division ? 1.0 : 0.0);
-}
-
 // absorb(first, scale) of a row of p regressors + target into R: rotations
-// i = first..p over the columns after i; with the inverse, rotations
-// i = first..p-1 also on R^-T's row i (columns [0, i]).
-double absorb_flops(std::size_t first, std::size_t p, bool track_inverse, bool inverse_division) {
+// i = first..p over the columns after i.
+double absorb_flops(std::size_t first, std::size_t p) {
   double f = 0.0;
-  for (std::size_t i = first; i <= p; ++i) {
-    f += rotation_flops(p - i);
-    if (track_inverse && i < p) f += inverse_rotation_flops(i + 1, inverse_division);
-  }
+  for (std::size_t i = first; i <= p; ++i) f += rotation_flops(p - i);
   return f;
 }
 
@@ -68,13 +57,13 @@ double ud_rss_prefix_flops(std::size_t p, std::size_t k) { return 3.0 * d(p - k)
 
 int prior_refresh_period(std::size_t p, double lambda) { return givens::prior_period(p, lambda); }
 
-double sqrt_rls_update_flops(std::size_t p, double lambda, bool track_inverse) {
-  double f = absorb_flops(0, p, track_inverse, false);  // the data row, sqrt(lambda) folded in
+double sqrt_rls_update_flops(std::size_t p, double lambda) {
+  double f = absorb_flops(0, p);  // the data row, sqrt(lambda) folded in
   if (lambda < 1.0) {
     // refresh_prior: every K samples a unit row at a round-robin index r in
     // [0, p), absorbed from row r with scale 1.
     double prior = 0.0;
-    for (std::size_t r = 0; r < p; ++r) prior += absorb_flops(r, p, track_inverse, true);
+    for (std::size_t r = 0; r < p; ++r) prior += absorb_flops(r, p);
     f += prior / d(p) / static_cast<double>(prior_refresh_period(p, lambda));
   }
   return f;
@@ -108,18 +97,19 @@ double ud_solve_prefix_flops(std::size_t k) {
 }
 
 double bierman_update_flops(std::size_t p, std::size_t block, double lambda) {
-  // absorb(): the a priori error (2p); per column j of U (padded(j) rows):
-  // the dot product with h (2 each), f, g, alpha (4), the new d (3), p_j (1),
-  // the column and gain update (4 each); the gain step k (1), beta += gain k
-  // (2p), the RSS (3) and the target's energy (4); the block covariances'
-  // downdates (per row 1, per lower-triangle entry 3).
-  const auto absorb = [&] {
+  // absorb() from column `first` on: the a priori error (2p); per column j
+  // of U (padded(j) rows): the dot product with h (2 each), f, g, alpha (4),
+  // the new d (3), p_j (1), the column and gain update (4 each); the gain
+  // step k (1), beta += gain k (2p), the RSS (3) and the target's energy
+  // (4); the block covariances' downdates (per row 1, per lower-triangle
+  // entry 3).
+  const auto absorb = [&](std::size_t first) {
     double f = 2.0 * d(p) + 1.0 + 2.0 * d(p) + 3.0 + 4.0 + 1.0;
-    for (std::size_t j = 0; j < p; ++j) f += 6.0 * d(givens::padded(j)) + 8.0;
+    for (std::size_t j = first; j < p; ++j) f += 6.0 * d(givens::padded(j)) + 8.0;
     for (std::size_t r = 0; r < block; ++r) f += d(p / block) * (1.0 + 3.0 * d(r + 1));
     return f;
   };
-  double f = absorb();
+  double f = absorb(0);
   // One block's covariance from U and D per sample, averaged over the
   // round robin: per column k >= b0, per stored row a its (a + 1) entries
   // (1 + 2 (a + 1)), and the diagonal's row inside the block.
@@ -131,7 +121,12 @@ double bierman_update_flops(std::size_t p, std::size_t block, double lambda) {
       if (stored < block) resync += 2.0 * d(stored) + 1.0;
     }
   f += resync / d(p / block);
-  if (lambda < 1.0) f += absorb() / static_cast<double>(prior_refresh_period(p, lambda));
+  if (lambda < 1.0) {
+    // The prior's unit row every K samples, from its round-robin column on.
+    double prior = 0.0;
+    for (std::size_t r = 0; r < p; ++r) prior += absorb(r);
+    f += prior / d(p) / static_cast<double>(prior_refresh_period(p, lambda));
+  }
   return f;
 }
 
@@ -154,27 +149,6 @@ double rss_without_flops(std::size_t p, std::size_t first, std::size_t count) {
   return f + sum_of_squares_flops(rows - cols + 1);
 }
 
-double rss_without_wald_flops(std::size_t p, std::size_t first, std::size_t count) {
-  if (count == 0) return rss_prefix_flops(p, p);
-  if (first + count >= p) return rss_prefix_flops(p, first);
-  double f = 0.0;
-  // Gram matrix S = M^T M (lower triangle) and g = M^T z, row k of M
-  // having min(count, k - first + 1) nonzeros: per nonzero a, 2 for g and
-  // 2 (a + 1) for S's row a.
-  for (std::size_t k = first; k < p; ++k) {
-    const std::size_t len = std::min(count, k - first + 1);
-    for (std::size_t a = 0; a < len; ++a) f += 2.0 + 2.0 * d(a + 1);
-  }
-  // Cholesky row a: for each b <= a a dot product of b terms (2b) and a
-  // division (b < a) or the square root (b = a); forward solve: 2a, a
-  // division, and quad += t^2 (2).
-  for (std::size_t a = 0; a < count; ++a) {
-    for (std::size_t b = 0; b <= a; ++b) f += 2.0 * d(b) + 1.0;
-    f += 2.0 * d(a) + 3.0;
-  }
-  return f + rss_prefix_flops(p, p) + 1.0;  // rss() + quad
-}
-
 namespace {
 
 // The Cholesky of a count x count block and the forward solve of g
@@ -191,40 +165,6 @@ double wald_quadratic_flops(std::size_t count) {
 }
 
 }  // namespace
-
-double tracked_blocks_update_flops(std::size_t p, std::size_t block, double lambda) {
-  // Every absorbed row (the data row, and 1/K prior rows): S_b = growth S_b
-  // - v_b v_b^T over each block's lower triangle (3 per entry); the data row
-  // also recomputes one block from L (rows k >= b0: per nonzero r of the
-  // row, 2 (r + 1)), averaged over the round-robin b0.
-  const double blocks = d(p / block);
-  const double triangle = d(block) * d(block + 1) / 2.0;
-  const double per_row = blocks * 3.0 * triangle;
-  double resync = 0.0;
-  for (std::size_t b0 = 0; b0 < p; b0 += block)
-    for (std::size_t k = b0; k < p; ++k)
-      for (std::size_t r = 0; r < std::min(block, k - b0 + 1); ++r) resync += 2.0 * d(r + 1);
-  resync /= blocks;
-  const double priors = lambda < 1.0 ? 1.0 / static_cast<double>(prior_refresh_period(p, lambda)) : 0.0;
-  return per_row * (1.0 + priors) + resync;
-}
-
-double tracked_block_wald_flops(std::size_t p, std::size_t count) {
-  // L^T z once per update, shared by the blocks (rows padded to 4 lanes, 2
-  // per entry), counted here once per block's share; then the block's
-  // Cholesky and solve, and rss() + quad.
-  double coef = 0.0;
-  for (std::size_t r = 0; r < p; ++r) coef += 2.0 * d((r + 4) / 4 * 4);
-  return coef / d(p / count) + wald_quadratic_flops(count) + rss_prefix_flops(p, p) + 1.0;
-}
-
-double solve_prefix_flops(std::size_t k) {
-  // Coefficient i: reciprocal of the diagonal and a product (2), then i
-  // multiply-subtracts into the coefficients above it (2i).
-  double f = 0.0;
-  for (std::size_t i = 0; i < k; ++i) f += 2.0 + 2.0 * d(i);
-  return f;
-}
 
 namespace {
 
@@ -285,10 +225,9 @@ MonitorFlops monitor_flops(std::size_t inputs, std::size_t outputs, const Monito
   const double n_out = d(outputs);
   MonitorFlops f;
   // NestedRls per output: the trapezoid of the a prefix rows (square-root
-  // free rotation i over the columns after i), the lower factor (a SqrtRls
-  // with its inverse takes the row scaled by sqrt(weight): a square root and
-  // a product per column), and every K_a samples the trapezoid's prior row
-  // (from a round-robin row r) passed on to the lower and pairwise factors.
+  // free rotation i over the columns after i), the lower factor, and every
+  // K_a samples the trapezoid's prior row (from a round-robin row r) passed
+  // on to the lower and pairwise factors.
   double shared = 0.0;
   for (std::size_t i = 0; i < a; ++i) shared += ud_rotation_flops(cols - 1 - i);
   shared += wald ? bierman_update_flops(p_lower, nb, lambda) : ud_rls_update_flops(p_lower, lambda);
@@ -297,8 +236,8 @@ MonitorFlops monitor_flops(std::size_t inputs, std::size_t outputs, const Monito
     for (std::size_t r = 0; r < a; ++r)
       for (std::size_t i = r; i < a; ++i) prior += ud_rotation_flops(cols - 1 - i);
     prior /= d(a);
-    // Passed on: the covariance form's absorb() without its resync, counted
-    // as a whole update (an upper bound by the resync's share); or UdRls's.
+    // Passed on: the covariance form's absorb() without forgetting, counted
+    // as a whole update (its resync included: an upper bound); or UdRls's.
     prior += wald ? bierman_update_flops(p_lower, nb, 1.0) : ud_absorb_flops(0, p_lower);
     prior += d(wald ? inputs : inputs - 1) * ud_absorb_flops(0, nb);
     shared += prior / static_cast<double>(prior_refresh_period(a, lambda));

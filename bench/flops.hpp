@@ -21,17 +21,19 @@
 
 namespace mpm::bench {
 
-// Flops of SqrtRls::update (or one model's share of update_staged, the same
-// arithmetic) with p regressors and forgetting lambda: one Givens rotation
-// per row of [R | target] with sqrt(lambda) folded in, plus, when
-// track_inverse, the same rotations on R^-T, plus, when lambda < 1, the
-// kept-alive prior row re-absorbed every K samples (averaged over K and over
-// the p round-robin starting rows).
-double sqrt_rls_update_flops(std::size_t p, double lambda, bool track_inverse);
-double sqrt_rls_update_flops(std::size_t, bool, bool) = delete;  // lambda is a number, not a flag
-// The same for UdRls (square-root-free rotations, no inverse).
+// Flops of SqrtRls::update with p regressors and forgetting lambda: one
+// Givens rotation per row of [R | target] with sqrt(lambda) folded in, plus,
+// when lambda < 1, the kept-alive prior row re-absorbed every K samples
+// (averaged over K and over the p round-robin starting rows).
+double sqrt_rls_update_flops(std::size_t p, double lambda);
+double sqrt_rls_update_flops(std::size_t, bool) = delete;  // lambda is a number, not a flag
+// The same for UdRls (square-root-free rotations).
 double ud_rls_update_flops(std::size_t p, double lambda);
 double ud_rls_update_flops(std::size_t, bool) = delete;
+// BiermanRls::update with p regressors in blocks of `block`: the one pass
+// over U, the tracked coefficients, RSS and block covariances, one block's
+// resync, and the prior row every K samples.
+double bierman_update_flops(std::size_t p, std::size_t block, double lambda);
 // The prior's refresh period K the core uses for p regressors and lambda
 // (core/givens.hpp).
 int prior_refresh_period(std::size_t p, double lambda);
@@ -40,24 +42,17 @@ int prior_refresh_period(std::size_t p, double lambda);
 double rss_without_flops(std::size_t p, std::size_t first, std::size_t count);
 // The same for UdRls::rss_without (R's rows formed from D and U first).
 double ud_rss_without_flops(std::size_t p, std::size_t first, std::size_t count);
-// Flops of SqrtRls::rss_without_wald(first, count) with the inverse tracked
-// (Gram matrix of the block's columns of R^-T, Cholesky, forward solve).
-double rss_without_wald_flops(std::size_t p, std::size_t first, std::size_t count);
-// With the block covariances tracked (SqrtRls wald_block): their per-update
-// upkeep, and one block's rss_without_wald.
-double tracked_blocks_update_flops(std::size_t p, std::size_t block, double lambda);
-double tracked_block_wald_flops(std::size_t p, std::size_t count);
-// Flops of SqrtRls::solve_prefix(k), and of UdRls's (unit diagonal).
-double solve_prefix_flops(std::size_t k);
+// Flops of UdRls::solve_prefix(k) (unit diagonal).
 double ud_solve_prefix_flops(std::size_t k);
 
 struct MonitorFlops {
   double full_updates = 0.0;      // one NestedRls per output: the shared rows of
                                   // [1, AR] and the lower factor of m nb (a
-                                  // SqrtRls with its inverse when m >=
-                                  // kWaldMinInputs, else a UdRls)
-  double pairwise_updates = 0.0;  // m - 1 pairwise lower factors of nb per
-                                  // output (the first input's is a prefix)
+                                  // BiermanRls when m >= kWaldMinInputs,
+                                  // else a UdRls)
+  double pairwise_updates = 0.0;  // pairwise lower factors of nb per output:
+                                  // m - 1 (the first input's is a prefix of a
+                                  // UdRls lower factor), m with a BiermanRls
   double conditional = 0.0;       // rss_without_block per (output, input)
   double other_statistics = 0.0;  // prefix RSS, logs, gamma (solve_prefix), n_eq
   double lags = 0.0;              // per-sample regressor pushes (Laguerre/lag

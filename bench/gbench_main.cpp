@@ -11,7 +11,9 @@
 #include "bench/flops.hpp"
 #include "bench/replay.hpp"
 #include "bench/workload.hpp"
+#include "core/bierman_rls.hpp"
 #include "core/sqrt_rls.hpp"
+#include "core/ud_rls.hpp"
 
 namespace mpm::bench {
 namespace {
@@ -63,12 +65,11 @@ void BM_Replay2x2(benchmark::State& state) {
 }
 BENCHMARK(BM_Replay2x2)->Arg(1000000)->Iterations(1)->Unit(benchmark::kSecond);
 
-// Parts of the update, for profiling: one square-root RLS update (p
+// Parts of the update, for profiling: one update of each factor kind (p
 // regressors; range(1) = 1: forgetting 0.999 with the prior row, 0: lambda =
 // 1), and one conditional RSS (rss_without of the first input block).
-void BM_SqrtRlsUpdate(benchmark::State& state) {
-  const auto p = static_cast<std::size_t>(state.range(0));
-  SqrtRls rls(p, state.range(1) ? 0.999 : 1.0, 1e-9);
+template <typename Factor>
+void update_factor(benchmark::State& state, Factor& rls, std::size_t p) {
   const Workload w = make_workload(p, 1, 512);
   std::size_t k = 0;
   for (auto _ : state) {
@@ -76,13 +77,35 @@ void BM_SqrtRlsUpdate(benchmark::State& state) {
     ++k;
   }
   benchmark::DoNotOptimize(rls.rss());
-  state.counters["flops"] = sqrt_rls_update_flops(p, state.range(1) ? 0.999 : 1.0, false);
-  // Rotations per update: the data row's p + 1, plus on average (p + 3) / 2
-  // for the prior row every K samples.
-  state.counters["givens"] = static_cast<double>(p + 1) +
-      (state.range(1) ? 0.5 * static_cast<double>(p + 3) / prior_refresh_period(p, 0.999) : 0.0);
 }
-BENCHMARK(BM_SqrtRlsUpdate)->ArgsProduct({{31, 41, 521}, {0, 1}});
+
+void BM_SqrtRlsUpdate(benchmark::State& state) {
+  const auto p = static_cast<std::size_t>(state.range(0));
+  const double lambda = state.range(1) ? 0.999 : 1.0;
+  SqrtRls rls(p, lambda, 1e-9);
+  update_factor(state, rls, p);
+  state.counters["flops"] = sqrt_rls_update_flops(p, lambda);
+}
+BENCHMARK(BM_SqrtRlsUpdate)->ArgsProduct({{31, 41, 520}, {0, 1}});
+
+void BM_UdRlsUpdate(benchmark::State& state) {
+  const auto p = static_cast<std::size_t>(state.range(0));
+  const double lambda = state.range(1) ? 0.999 : 1.0;
+  UdRls rls(p, lambda, 1e-9);
+  update_factor(state, rls, p);
+  state.counters["flops"] = ud_rls_update_flops(p, lambda);
+}
+BENCHMARK(BM_UdRlsUpdate)->ArgsProduct({{31, 41, 520}, {0, 1}});
+
+// The monitor's lower factor from 4 inputs on (blocks of nb = 10).
+void BM_BiermanRlsUpdate(benchmark::State& state) {
+  const auto p = static_cast<std::size_t>(state.range(0));
+  const double lambda = state.range(1) ? 0.999 : 1.0;
+  BiermanRls rls(p, 10, lambda, 1e-9);
+  update_factor(state, rls, p);
+  state.counters["flops"] = bierman_update_flops(p, 10, lambda);
+}
+BENCHMARK(BM_BiermanRlsUpdate)->ArgsProduct({{40, 500}, {0, 1}});
 
 void BM_RssWithout(benchmark::State& state) {
   const auto p = static_cast<std::size_t>(state.range(0));

@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include "core/givens.hpp"
-#include "core/sqrt_rls.hpp"
 
 namespace mpm {
 
@@ -14,6 +13,39 @@ using givens::Lanes;
 using givens::load;
 using givens::padded;
 using givens::store;
+
+namespace {
+
+// g^T S^-1 g for the Wald identity: S in the lower triangle of scratch rows
+// [0, count), g in row `count`; -1 if S is not positive definite.
+double wald_quadratic(BiermanRls::Matrix& scratch, std::size_t count) noexcept {
+  // S in the lower triangle of scratch rows [0, count), g in row `count`.
+  // Cholesky S = C C^T in place, forward solve C t = g; g^T S^-1 g = |t|^2.
+  // -1 when S is not positive definite.
+  double* g = scratch.row(static_cast<Eigen::Index>(count)).data();
+  double quad = 0.0;
+  for (std::size_t a = 0; a < count; ++a) {
+    double* ca = scratch.row(static_cast<Eigen::Index>(a)).data();
+    for (std::size_t b = 0; b <= a; ++b) {
+      const double* cb = scratch.row(static_cast<Eigen::Index>(b)).data();
+      double sum = ca[b];
+      for (std::size_t k = 0; k < b; ++k) sum -= ca[k] * cb[k];
+      if (b < a) {
+        ca[b] = sum / cb[b];
+      } else {
+        if (!(sum > 0.0)) return -1.0;  // not positive definite
+        ca[a] = std::sqrt(sum);
+      }
+    }
+    double t = g[a];
+    for (std::size_t k = 0; k < a; ++k) t -= ca[k] * g[k];
+    g[a] = t / ca[a];
+    quad += g[a] * g[a];
+  }
+  return quad;
+}
+
+}  // namespace
 
 BiermanRls::BiermanRls(std::size_t n_regressors, std::size_t block, double forgetting, double regularization)
     : p_(n_regressors), nb_(block), lambda_(forgetting), delta_(regularization) {
@@ -82,11 +114,11 @@ void BiermanRls::refresh_prior() noexcept {
   double* h = h_.data();
   std::fill(h, h + p_ + 1, 0.0);
   h[next_prior_row_] = prior_weight_;
-  absorb(1.0, 1.0);
+  absorb(1.0, 1.0, next_prior_row_);
   next_prior_row_ = (next_prior_row_ + 1) % p_;
 }
 
-void BiermanRls::absorb(double weight, double lambda) noexcept {
+void BiermanRls::absorb(double weight, double lambda, std::size_t first) noexcept {
   const double growth = 1.0 / lambda;
   double* __restrict h = h_.data();
   const double y = h[p_];
@@ -110,7 +142,8 @@ void BiermanRls::absorb(double weight, double lambda) noexcept {
   // gain ends as P h (P before this row), alpha as lambda / weight + h^T P h.
   std::fill(gain, gain + gain_.size(), 0.0);
   double alpha = lambda / weight;
-  for (std::size_t j = 0; j < p_; ++j) {
+  if (lambda != 1.0) first = 0;  // forgetting touches every d_j
+  for (std::size_t j = first; j < p_; ++j) {
     double* col = u + column_[static_cast<Eigen::Index>(j)];
     const std::size_t len = padded(j);  // rows [j, len) are zero padding, as gain is there
     // Four partial sums: one would make the column wait on the adder's
@@ -184,11 +217,11 @@ double BiermanRls::rss_without_block(std::size_t i, Matrix& scratch) const noexc
     std::copy(src, src + a + 1, scratch.row(static_cast<Eigen::Index>(a)).data());
   }
   fill_g();
-  double quad = SqrtRls::wald_quadratic(scratch, nb_);
+  double quad = wald_quadratic(scratch, nb_);
   if (quad < 0.0) {  // the tracked block lost definiteness to rounding: from the factor
     block_covariance_from_factor(b0, scratch.data(), static_cast<std::size_t>(scratch.cols()));
     fill_g();
-    quad = SqrtRls::wald_quadratic(scratch, nb_);
+    quad = wald_quadratic(scratch, nb_);
   }
   return quad >= 0.0 ? rss_ + quad : NAN;
 }

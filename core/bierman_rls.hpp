@@ -91,8 +91,10 @@ class BiermanRls {
   double energy_ = 0.0;
 
   // Absorbs h_ (target at h_[p]) with `weight`; `lambda` forgets the past
-  // first (1: none).
-  void absorb(double weight, double lambda) noexcept;
+  // first (1: none). Without forgetting, h_[0, first) == 0 may be promised:
+  // those columns would see f_j = 0 and keep their values, so they are
+  // skipped (the kept-alive prior's unit rows: half the work on average).
+  void absorb(double weight, double lambda, std::size_t first = 0) noexcept;
   // [P]_bb of the block starting at b0 from U and D, lower triangle, into
   // rows of `out` (stride `ld`).
   void block_covariance_from_factor(std::size_t b0, double* out, std::size_t ld) const noexcept;

@@ -1,7 +1,8 @@
 // Covariance-form UD RLS (BiermanRls) against the information-form factor
-// it stands in for in the monitor's Wald tests: SqrtRls with its inverse
-// tracked. Its coefficients and RSS are recursions, so they are compared
-// over long runs, with and without forgetting, with weighted rows.
+// (SqrtRls): its coefficients, RSS and Wald conditional RSS against the
+// factor's back substitution, prefix sums and re-triangularisation. Its
+// coefficients and RSS are recursions, so they are compared over long runs,
+// with and without forgetting, with weighted rows.
 #include <cmath>
 #include <random>
 #include <vector>
@@ -22,7 +23,7 @@ double rel(double a, double b) { return std::abs(a - b) / std::abs(b); }
 void expect_equal_to_sqrt_rls(double lambda, int samples, double tol, double regularization) {
   const std::size_t nb = 5, blocks = 6, p = nb * blocks;
   BiermanRls bierman(p, nb, lambda, regularization);
-  SqrtRls sqrt_rls(p, lambda, regularization, true, nb);
+  SqrtRls sqrt_rls(p, lambda, regularization);
   DataGen gen(static_cast<int>(p));
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> weight(0.05, 2.0);

@@ -21,8 +21,8 @@ struct SeparateFits {
   std::size_t a, m, nb;
   SqrtRls full;
   std::vector<SqrtRls> pair;
-  SeparateFits(std::size_t a_, std::size_t m_, std::size_t nb_, double lambda, bool track_inverse = false)
-      : a(a_), m(m_), nb(nb_), full(a_ + m_ * nb_, lambda, kDelta, track_inverse),
+  SeparateFits(std::size_t a_, std::size_t m_, std::size_t nb_, double lambda)
+      : a(a_), m(m_), nb(nb_), full(a_ + m_ * nb_, lambda, kDelta),
         pair(m_, SqrtRls(a_ + nb_, lambda, kDelta)) {}
   void update(const std::vector<double>& x, double y) {
     full.update(x.data(), y);
