@@ -12,7 +12,10 @@ struct ReplayResult {
   double samples_per_s = 0.0;           // one thread, thread CPU time
   double parallel_samples_per_s = 0.0;  // as `mpm monitor` runs it: residuals,
                                         // then the outputs over `threads`
-                                        // threads; wall-clock time
+                                        // threads; wall-clock time, median
+                                        // of kParallelRuns runs
+  double parallel_runs[3] = {};         // each run's rate
+  static constexpr int kParallelRuns = 3;
   std::size_t threads = 1;
   bool parallel_identical = false;      // the split changed no statistic
   std::size_t samples = 0;

@@ -27,9 +27,10 @@ struct Size {
   std::size_t repeats;
 };
 
-std::string fmt(const char* format, double a, double b = 0.0, double c = 0.0) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, format, a, b, c);
+template <typename... Numbers>
+std::string fmt(const char* format, Numbers... values) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, format, static_cast<double>(values)...);
   return buf;
 }
 
@@ -208,8 +209,9 @@ void replay_figure(Plan& plan, std::int64_t& allocations, std::size_t& updates) 
   plan.add("replay_samples_per_s_2x2", r.parallel_samples_per_s, "samples/s",
            fmt("%.0f-sample recording in memory (Wood-Berry, built-in plant) replayed as `mpm monitor` does: "
                "ResidualGenerator, then GrangerMonitor (na=20 nb=10 lambda=0.999, gamma on) with the outputs "
-               "split over %.0f threads, wall-clock time; statistics ",
-               static_cast<double>(samples), static_cast<double>(r.threads)) +
+               "split over %.0f threads, wall-clock time, median of 3 runs (%.0f, %.0f, %.0f); statistics ",
+               static_cast<double>(samples), static_cast<double>(r.threads), r.parallel_runs[0], r.parallel_runs[1],
+               r.parallel_runs[2]) +
                (r.parallel_identical ? "identical to the one-thread replay's" : "DIFFERENT FROM the one-thread replay's"));
   plan.add("replay_samples_per_s_2x2_one_thread", r.samples_per_s, "samples/s",
            "the same replay on one thread (residual and monitor per sample), thread CPU time");

@@ -123,7 +123,7 @@ void NestedRls::update_staged(NestedRls* models, std::size_t count) noexcept {
     }
   // Then every lower factor: the small ones a few at a time, a covariance-
   // form one alone (its one pass over its columns has latency to spare).
-  UdRls* group[kLockstep];
+  UdRls* group[kLockstep] = {};
   std::size_t in_group = 0;
   const auto add = [&](UdRls& lower) {
     if (lower.n_regressors() > kLockstepMaxRegressors) {
