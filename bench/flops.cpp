@@ -152,7 +152,7 @@ double rss_without_flops(std::size_t p, std::size_t first, std::size_t count) {
 namespace {
 
 // The Cholesky of a count x count block and the forward solve of g
-// (SqrtRls::wald_quadratic): row a: for each b <= a a dot product of b
+// (bierman_rls.cpp, wald_quadratic): row a: for each b <= a a dot product of b
 // terms (2b) and a division or the square root; the solve: 2a, a division,
 // and quad += t^2 (2).
 double wald_quadratic_flops(std::size_t count) {

@@ -14,8 +14,8 @@
 // reads and writes U once, column by column (column j's part of U^T x is
 // formed just before the column is updated, from its old values), with three
 // multiply-adds per entry and no square root: half the memory traffic and a
-// third of the arithmetic of a tracked-inverse SqrtRls, which matters once
-// the factors outgrow the caches (50 inputs: 1 MB per output).
+// third of the arithmetic of an information factor carrying R^-T, which
+// matters once the factors outgrow the caches (50 inputs: 1 MB per output).
 //
 // Tracked beside U and D: the coefficients (beta += K e), the RSS (+= lambda
 // e^2 / alpha, the innovation's weight), the target's energy (the RSS of the

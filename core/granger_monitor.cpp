@@ -11,10 +11,11 @@ namespace mpm {
 namespace {
 
 constexpr double kRegularization = 1e-9;
-// From this many inputs on, the conditional statistics come from the Wald
-// identity on a tracked inverse factor (O(p nb^2) per input, the inverse
-// doubling the full model's update) instead of re-triangularisation
-// (O(p^2 nb) per input); below it the extra update costs more than it saves.
+// From this many inputs on, the full model's lower factor is kept in
+// covariance form (BiermanRls) and the conditional statistics come from the
+// Wald identity (O(nb^3) per input) instead of re-triangularisation
+// (O(p^2 nb) per input); below it the covariance form's update and the
+// pairwise factor it needs for the first input cost more than they save.
 constexpr std::size_t kWaldMinInputs = 4;
 // Divergence: the residual's short-memory variance exceeds this many times
 // the matched-model variance (amplitude x 10), or, where that is unknown,

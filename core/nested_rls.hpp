@@ -61,7 +61,7 @@ class NestedRls {
 
   // Real-time safe. x: n_regressors() values [A, B_1 .. B_m], y: target.
   void update(const double* x, double y) noexcept;
-  // The same in two steps (see SqrtRls::update_staged): write x then y into
+  // The same in two steps (see UdRls::update_staged): write x then y into
   // staged_row() (n_regressors() + 1 values) of each model, then
   // update_staged() interleaves the rotations of all of them.
   double* staged_row() noexcept { return row_.data(); }

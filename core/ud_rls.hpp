@@ -4,8 +4,8 @@
 // diagonal weights) and updated by Gentleman's square-root-free Givens
 // rotations (givens.hpp). Each absorbed row costs three operations per
 // entry instead of four and one division per row instead of a square root
-// and a division, so it is the factor of choice where nothing needs R^-T
-// (SqrtRls's tracked inverse, for the Wald tests of many blocks).
+// and a division: the monitor's factor wherever it does not need the
+// covariance's blocks (there BiermanRls keeps the covariance itself).
 //
 // What the monitor reads is as cheap as from R: with z the target column of
 // U, the RSS of the model of the first k regressors is
