@@ -1,5 +1,6 @@
 // Minimal `--name value` / `--flag` option parsing for the mpm subcommands:
-// every option is declared, unknown ones are usage errors.
+// every option is declared, unknown ones are usage errors. A valued option
+// given more than once keeps every value (all()); get() sees the last.
 #pragma once
 
 #include <cstdlib>
@@ -8,6 +9,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace mpm {
 
@@ -38,7 +40,7 @@ class Args {
           if (i + 1 >= argc) throw UsageError("--" + a + " needs a value");
           value = argv[++i];
         }
-        values_[a] = value;
+        values_[a].push_back(value);
       } else {
         throw UsageError("unknown option --" + a);
       }
@@ -48,7 +50,12 @@ class Args {
   std::optional<std::string> get(const std::string& name) const {
     auto it = values_.find(name);
     if (it == values_.end()) return std::nullopt;
-    return it->second;
+    return it->second.back();
+  }
+  // Every value of a repeatable option, in command-line order.
+  std::vector<std::string> all(const std::string& name) const {
+    auto it = values_.find(name);
+    return it == values_.end() ? std::vector<std::string>{} : it->second;
   }
   std::string required(const std::string& name) const {
     auto v = get(name);
@@ -70,7 +77,7 @@ class Args {
   }
 
  private:
-  std::map<std::string, std::string> values_;
+  std::map<std::string, std::vector<std::string>> values_;
   std::set<std::string> flags_;
 };
 

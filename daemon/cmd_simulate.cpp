@@ -6,28 +6,41 @@
 #include <cstdlib>
 #include <exception>
 #include <string>
+#include <vector>
 
 #include "config/plant_loader.hpp"
 #include "daemon/args.hpp"
 #include "daemon/command.hpp"
 #include "sim/closed_loop.hpp"
+#include "sim/edit_spec.hpp"
 #include "sim/scenarios.hpp"
 
 namespace mpm {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: mpm simulate --scenario NAME [--plant PLANT.yaml] [--samples N] [--seed S] --out RUN.csv\n"
+    "usage: mpm simulate --scenario NAME [--plant PLANT.yaml] [--samples N] [--seed S] [--edit SPEC]... --out RUN.csv\n"
     "       mpm simulate --list\n"
     "  Runs the closed loop of the scenario (DMC with IMC bias correction on the plant file's\n"
-    "  model; the plant differs from it as the scenario says) and writes t, inputs, outputs and\n"
-    "  r_<output> (plus any extra recorded signal) in absolute units.\n"
+    "  model; the plant differs from it as the scenario says, plus any --edit) and writes t,\n"
+    "  inputs, outputs and r_<output> (plus any extra recorded signal) in absolute units.\n"
     "options:\n"
     "  --scenario NAME  which scenario (--list shows them)\n"
     "  --plant FILE     the nominal model (default: the scenario's file under config/, looked up\n"
     "                   in $MPM_CONFIG_DIR, the source tree and the install dir, else built in)\n"
     "  --samples N      samples to record (default 3000)\n"
     "  --seed S         random seed of noise and setpoint changes (default 1); same seed, same run\n"
+    "  --edit SPEC      make the plant differ from the model (repeatable; names as in the plant file):\n"
+    "                     OUTPUT.INPUT.KEY=VALUE  channel: gain (factor), pole (factor > 0 on every\n"
+    "                       discrete pole), time_constant (factor > 0, gain kept), delay (extra\n"
+    "                       samples, 0..10000), lag (pole of an extra unit-gain lag, [0, 1)),\n"
+    "                       integrator (no value or =1; =0 removes the scenario's)\n"
+    "                     INPUT.KEY=VALUE   actuator: actuator_lag (pole, [0, 1)), lower (<= 0) and\n"
+    "                       upper (>= 0) stops in deviation from the operating point, deadband (>= 0)\n"
+    "                     OUTPUT.sensor_lag=VALUE   transmitter lag (pole, [0, 1))\n"
+    "                   e.g. --edit y2.u1.gain=0.8 --edit u2.actuator_lag=0.45 --edit y1.sensor_lag=0.5\n"
+    "                   Edits of one channel/input/output combine; a key the scenario already sets\n"
+    "                   there is replaced, its other keys stay. Bad names, keys or values: exit 2.\n"
     "  --out FILE       where to write the recording CSV\n"
     "  --list           list the scenarios and exit\n";
 
@@ -53,13 +66,29 @@ std::size_t parse_samples(const Args& args) {
   return static_cast<std::size_t>(n);
 }
 
+int usage_error(const std::string& what) {
+  std::fprintf(stderr, "mpm simulate: %s\n%s", what.c_str(), kUsage);
+  return 2;
+}
+
+// The scenario's loop with the --edit specs applied to its plant; the names
+// are the plant file's, so this runs once the plant is loaded.
+sim::LoopConfig edited_loop(const sim::Scenario& scenario, const PlantModel& model,
+                            const std::vector<std::string>& texts, std::vector<sim::EditSpec>& specs) {
+  sim::LoopConfig loop = scenario.loop;
+  for (const auto& text : texts) specs.push_back(sim::parse_edit(text, model.inputs, model.outputs));
+  sim::apply_edits(specs, loop.plant);
+  return loop;
+}
+
 int run_simulate(int argc, char** argv) {
   std::string out_path, scenario_name;
+  std::vector<std::string> edit_texts;
   std::size_t samples = 0;
   std::uint64_t seed = 0;
   std::optional<std::string> plant_path;
   try {
-    const Args args(argc, argv, {"plant", "scenario", "samples", "seed", "out"}, {"list", "help"});
+    const Args args(argc, argv, {"plant", "scenario", "samples", "seed", "out", "edit"}, {"list", "help"});
     if (args.flag("help")) {
       std::fputs(kUsage, stdout);
       return 0;
@@ -73,28 +102,35 @@ int run_simulate(int argc, char** argv) {
     samples = parse_samples(args);
     seed = parse_seed(args);
     plant_path = args.get("plant");
+    edit_texts = args.all("edit");
     if (!sim::find_scenario(scenario_name))
       throw UsageError("unknown scenario '" + scenario_name + "' (mpm simulate --list shows them)");
   } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm simulate: %s\n%s", e.what(), kUsage);
-    return 2;
+    return usage_error(e.what());
   }
   try {
     const sim::Scenario& scenario = *sim::find_scenario(scenario_name);
     sim::ResolvedPlant plant = plant_path ? sim::ResolvedPlant{config::load_plant(*plant_path), *plant_path}
                                           : sim::default_plant(scenario);
+    std::vector<sim::EditSpec> edits;
+    sim::LoopConfig loop_config;
+    try {
+      loop_config = edited_loop(scenario, plant.model, edit_texts, edits);
+    } catch (const std::invalid_argument& e) {
+      return usage_error(std::string("--edit ") + e.what());
+    }
+    const std::string what = edits.empty() ? scenario.name : scenario.name + " with --edit " + sim::describe(edits);
     sim::ClosedLoop loop = [&] {
       try {
-        return sim::ClosedLoop(plant.model, scenario.loop, seed);
+        return sim::ClosedLoop(plant.model, loop_config, seed);
       } catch (const std::invalid_argument& e) {
-        throw std::runtime_error("scenario " + scenario.name + " does not fit the plant " + plant.source + ": " +
-                                 e.what());
+        throw std::runtime_error("scenario " + what + " does not fit the plant " + plant.source + ": " + e.what());
       }
     }();
     const config::Recording rec = sim::simulate(loop, samples, out_path);
     config::write_recording(out_path, rec);
     std::printf("wrote %s: %zu samples of %s (plant %s, seed %llu); input limits active at %zu samples\n",
-                out_path.c_str(), samples, scenario.name.c_str(), plant.source.c_str(),
+                out_path.c_str(), samples, what.c_str(), plant.source.c_str(),
                 static_cast<unsigned long long>(seed), loop.controller().constrained_samples());
     return 0;
   } catch (const std::exception& e) {
