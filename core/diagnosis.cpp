@@ -308,6 +308,7 @@ std::vector<Candidate> generate(const Context& cx, const std::set<std::pair<std:
   if (progress) progress("channel hypotheses fitted");
   for (std::size_t i = 0; i < cx.n_in(); ++i) column_hypotheses(cx, i, all);
   for (std::size_t j = 0; j < cx.n_out(); ++j) row_hypotheses(cx, j, all);
+  plant_hypotheses(cx, all);
   if (progress) progress("column and row hypotheses fitted");
   // A loose screen (5 %, plain lags have little power on slow responses):
   // the decision is the structured fit's own test below, Bonferroni-corrected.

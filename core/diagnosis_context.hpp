@@ -88,6 +88,8 @@ double tau_of(double pole);
 void channel_hypotheses(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out);
 void column_hypotheses(const Context& cx, std::size_t i, std::vector<Candidate>& out);
 void row_hypotheses(const Context& cx, std::size_t j, std::vector<Candidate>& out);
+// Hypotheses over every output at once (a gain set by each output's level).
+void plant_hypotheses(const Context& cx, std::vector<Candidate>& out);
 void signal_hypotheses(const Context& cx, std::size_t j, std::size_t column, std::vector<Candidate>& out);
 
 // Granger test of extra column `column` on output j's residual, given the

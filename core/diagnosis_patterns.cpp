@@ -117,6 +117,72 @@ void nonlinear_gain(const Context& cx, std::size_t i, const std::vector<std::siz
   out.push_back(std::move(c));
 }
 
+// The model's prediction of output j, sum_i G_ji du_i over the excited
+// inputs with a channel, and those channels.
+struct RowPrediction {
+  std::vector<Channel> channels;
+  Vec total;
+};
+RowPrediction row_prediction(const Context& cx, std::size_t j) {
+  RowPrediction r{{}, Vec::Zero(cx.problem.du.rows())};
+  for (std::size_t i = 0; i < cx.n_in(); ++i)
+    if (cx.has_channel(j, i) && cx.excited[i]) {
+      r.channels.push_back({j, i});
+      r.total += cx.gu[j * cx.n_in() + i];
+    }
+  return r;
+}
+
+// Gain varying with the output's own level: y = G u (1 + b G u), the
+// correction b (G_M u)^2 over the whole row, one slope b per output. A
+// process linearised at one operating point and run away from it has this
+// form (a tank: every gain into it scales with the square root of its
+// level): the level sets the gain of every input into that output at once,
+// which per-input u^2 terms cannot say when the inputs move together in
+// closed loop. Over several outputs it is one candidate, so that it is
+// weighed as one explanation against the per-input ones.
+// Under feedback G_M u mirrors the disturbance the controller rejects, so
+// its square can take up a disturbance model that the whitener has wrong.
+// The level gain must therefore still explain the residual significantly
+// when fitted jointly with a change of the disturbance model (as the sensor
+// hypothesis is checked);
+// otherwise it is left to the disturbance-model step.
+void level_gain(const Context& cx, const std::vector<std::size_t>& js, std::vector<Candidate>& out) {
+  std::vector<OutputFit> fits, noise_only, joint;
+  std::vector<Channel> cs;
+  for (std::size_t j : js) {
+    const RowPrediction row = row_prediction(cx, j);
+    const Vec square = row.total.cwiseProduct(row.total);
+    const OutputState& o = cx.out[j];
+    // Lags of the residual, whitened, are lags of the whitened residual: an
+    // AR(3) change of the disturbance model, the disturbance-model step's own.
+    const Vec& r = o.signals.empty() ? o.d : o.base;
+    std::vector<Vec> previous{shifted(r, 1), shifted(r, 2), shifted(r, 3)};
+    fits.push_back(fit_output(cx, j, Vec(), {square}));
+    noise_only.push_back(fit_output(cx, j, Vec(), previous));
+    previous.push_back(square);
+    joint.push_back(fit_output(cx, j, Vec(), previous));
+    cs.insert(cs.end(), row.channels.begin(), row.channels.end());
+  }
+  const double lr_given_noise = objective(cx, noise_only) - objective(cx, joint);
+  if (lr_given_noise < chi_square_quantile_upper(cx.settings.alpha, static_cast<double>(js.size()))) return;
+  const auto first = static_cast<std::size_t>(cs[0].input.value());
+  Candidate c = make_candidate(cx, "nonlinear_gain", cs, fits, static_cast<int>(js.size()));
+  c.finding.nominal = *cx.channel(js[0], first);
+  c.finding.fitted = *cx.channel(js[0], first);
+  std::string slopes;
+  for (std::size_t r = 0; r < js.size(); ++r) {
+    const std::string& name = cx.problem.outputs[js[r]];
+    const double b = fits[r].fit.theta(0);
+    c.finding.parameters["gain_slope_per_unit_" + name] = b;
+    slopes += (r ? ", " : "") + fmt(b) + " per unit of " + name;
+  }
+  c.finding.summary = "gain of every input into " +
+                      (js.size() == 1 ? cx.problem.outputs[js[0]] : std::string("each output")) +
+                      " changes with that output's level (relative slope " + slopes + ")";
+  out.push_back(std::move(c));
+}
+
 }  // namespace
 
 void column_hypotheses(const Context& cx, std::size_t i, std::vector<Candidate>& out) {
@@ -130,14 +196,11 @@ void column_hypotheses(const Context& cx, std::size_t i, std::vector<Candidate>&
 }
 
 void row_hypotheses(const Context& cx, std::size_t j, std::vector<Candidate>& out) {
-  std::vector<Channel> cs;
-  Vec total = Vec::Zero(cx.problem.du.rows());
-  for (std::size_t i = 0; i < cx.n_in(); ++i)
-    if (cx.has_channel(j, i) && cx.excited[i]) {
-      cs.push_back({j, i});
-      total += cx.gu[j * cx.n_in() + i];
-    }
+  const RowPrediction row = row_prediction(cx, j);
+  const std::vector<Channel>& cs = row.channels;
+  const Vec& total = row.total;
   if (cs.size() < 2) return;
+  level_gain(cx, {j}, out);
   // A transmitter lag S = (1 - a) / (1 - a q^-1) filters everything the
   // sensor sees, the model-predicted part and the disturbances alike: the
   // measured output is x = S x_true, with x = r + G_M u (r the residual, the
@@ -226,6 +289,13 @@ void signal_hypotheses(const Context& cx, std::size_t j, std::size_t column, std
                       ", time constant " + fmt(tau_of(fo.pole) * cx.problem.sample_time) + " s, delay " +
                       std::to_string(fo.delay) + " samples";
   out.push_back(std::move(c));
+}
+
+void plant_hypotheses(const Context& cx, std::vector<Candidate>& out) {
+  std::vector<std::size_t> js;
+  for (std::size_t j = 0; j < cx.n_out(); ++j)
+    if (!row_prediction(cx, j).channels.empty()) js.push_back(j);
+  if (js.size() >= 2) level_gain(cx, js, out);
 }
 
 }  // namespace mpm::diagnosis

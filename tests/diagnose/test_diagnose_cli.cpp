@@ -18,13 +18,16 @@ using mpm::test::read_file;
 std::string tmp_path(const std::string& name) { return mpm::test::tmp_path("mpm_diag_", name); }
 int run(const std::string& cmd) { return mpm::test::run_quietly(cmd); }
 
-// Simulates a scenario and diagnoses it; returns the report text.
-std::string diagnose_scenario(const std::string& scenario, int seed, int samples = 3000) {
+const std::string kQuadTank = std::string(MPM_SOURCE_DIR) + "/config/quad-tank.yaml";
+
+// Simulates a scenario and diagnoses it against `plant`; returns the report text.
+std::string diagnose_scenario(const std::string& scenario, int seed, int samples = 3000,
+                              const std::string& plant = kWoodBerry) {
   const std::string csv = tmp_path(scenario + ".csv"), out = tmp_path(scenario + ".json");
   EXPECT_EQ(run(kMpm + " simulate --scenario " + scenario + " --samples " + std::to_string(samples) + " --seed " +
                 std::to_string(seed) + " --out " + csv),
             0);
-  EXPECT_EQ(run(kMpm + " diagnose --quiet --plant " + kWoodBerry + " --data " + csv + " --json " + out), 0);
+  EXPECT_EQ(run(kMpm + " diagnose --quiet --plant " + plant + " --data " + csv + " --json " + out), 0);
   return read_file(out);
 }
 
@@ -87,6 +90,27 @@ TEST(DiagnoseCli, NominalPlantGivesNoFinding) {
     EXPECT_NE(r.find("\"mismatch\": false"), std::string::npos) << "seed " << seed;
     EXPECT_TRUE(physics_words(r).empty()) << "seed " << seed;
   }
+}
+
+// The tank run well below the point its model was linearised at: every
+// gain into a tank scales with the root of its level, so the whole plant's
+// gain moves with the levels. Named as one finding over all four channels,
+// not as one pump's column (the pumps move together in closed loop, so the
+// second column adds too little once the first is in) plus a plain gain.
+TEST(DiagnoseCli, QuadTankAwayFromItsLinearisationIsALevelGainOnEveryChannel) {
+  for (int seed : {31, 32}) {
+    const std::string r = diagnose_scenario("quad-tank-wide-low", seed, 4000, kQuadTank);
+    EXPECT_EQ(physics_words(r), std::set<std::string>{"nonlinear_gain"}) << "seed " << seed << ":\n" << r;
+    for (const char* level : {"level1", "level2"})
+      for (const char* pump : {"\"pump1\"", "\"pump2\""})
+        EXPECT_TRUE(names_channel(r, level, pump)) << "seed " << seed << ": " << level << " <- " << pump;
+  }
+}
+
+TEST(DiagnoseCli, QuadTankNearItsLinearisationGivesNoFinding) {
+  const std::string r = diagnose_scenario("quad-tank-nominal", 33, 4000, kQuadTank);
+  EXPECT_NE(r.find("\"mismatch\": false"), std::string::npos) << r;
+  EXPECT_TRUE(physics_words(r).empty()) << r;
 }
 
 TEST(DiagnoseCli, ErrorsNameTheFileAndUseExitCodes) {
