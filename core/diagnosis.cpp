@@ -28,6 +28,7 @@ OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std:
   f.fit = least_squares(target, regs, cx.seg);
   f.correction = c0.size() ? c0 : Vec::Zero(o.d.size());
   for (std::size_t l = 0; l < X.size(); ++l) f.correction += f.fit.theta(static_cast<Index>(l)) * X[l];
+  f.fixed = c0;
   f.regressors = X;
   if (joint) {
     const auto nx = static_cast<Index>(X.size()), ns = static_cast<Index>(o.signals.size());
@@ -39,6 +40,8 @@ OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std:
   }
   return f;
 }
+
+std::vector<Vec> noise_change_regressors(const Vec& r) { return {shifted(r, 1), shifted(r, 2), shifted(r, 3)}; }
 
 double objective(const Context& cx, const std::vector<OutputFit>& fits) {
   double s = 0.0;
@@ -95,6 +98,21 @@ void score(const Context& cx, Candidate& c) {
     c.hold_gain += std::log(o.hold_var / f.fit.hold_var);
   }
   c.z_hold = var > 0.0 ? num / std::sqrt(var) : 0.0;
+
+  // Under feedback G_M u mirrors the disturbances the controller rejects, so
+  // a correction built from it can take up a disturbance model that the
+  // whitener has wrong. Refitted jointly with an AR(3) change of that model
+  // (the lags of the residual the correction leaves, so that they cannot
+  // take up the correction itself), a real process change still explains
+  // the residual; one that rode on the wrong N does not.
+  double beyond = 0.0;
+  for (const auto& f : c.fits) {
+    const OutputState& o = cx.out[f.output];
+    std::vector<Vec> X = f.regressors;
+    for (Vec& lag : noise_change_regressors(o.d - f.correction)) X.push_back(std::move(lag));
+    beyond += std::log(o.noise_change_var / fit_output(cx, f.output, f.fixed, X).fit.fit_var);
+  }
+  c.lr_beyond_noise = beyond * static_cast<double>(cx.seg.fit_samples());
 }
 
 namespace {
@@ -115,6 +133,7 @@ void refresh(Context& cx, std::size_t j) {
   o.fit_var = f.fit_var;
   o.hold_var = f.hold_var;
   o.hold_error = f.hold_error;
+  o.noise_change_var = fit_output(cx, j, Vec(), noise_change_regressors(o.d)).fit.fit_var;
 }
 
 std::vector<int> valid_runs(const std::vector<char>& valid) {
@@ -334,8 +353,11 @@ std::vector<Candidate> generate(const Context& cx, const std::set<std::pair<std:
 // (held-out level): the fit level is alpha / hold level, shared over the family.
 double fit_level(const Settings& s, double family) { return s.alpha / s.holdout_level / family; }
 
+// A recorded signal is not moved by the controller, so it is not held to
+// the test against a changed disturbance model (see score()).
 bool passes(const Candidate& c, const Settings& s, double family) {
-  return c.lr >= chi_square_quantile_upper(fit_level(s, family), c.params) && c.z_hold >= s.holdout_z && c.hold_gain > 0.0;
+  return c.lr >= chi_square_quantile_upper(fit_level(s, family), c.params) && c.z_hold >= s.holdout_z &&
+         c.hold_gain > 0.0 && (c.finding.signal || c.lr_beyond_noise >= chi_square_quantile_upper(s.alpha, c.params));
 }
 
 // The fit block: one-step prediction-error variances (the whitened residual

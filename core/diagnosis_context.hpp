@@ -28,6 +28,7 @@ struct OutputState {
   std::vector<Vec> wsignals;  // whitened
   Vec signal_theta;           // their coefficients in the signals-only fit: d = base - sum theta signal
   double fit_var = 1.0;   // whitened variance now, fit part
+  double noise_change_var = 1.0;  // whitened variance, fit part, after an AR(3) change of the disturbance model alone
   double hold_var = 1.0;  // whitened variance now, held-out part
   Vec hold_error;         // whitened, mean-removed errors on the held-out part
 };
@@ -57,6 +58,7 @@ struct OutputFit {
   std::size_t output = 0;
   Vec correction;   // raw, full length: the change of d (with the signals' refitted coefficients)
   LinearFit fit;    // whitened; theta holds the hypothesis' own coefficients only
+  Vec fixed;                    // the hypothesis' fixed correction c0 (may be empty)
   std::vector<Vec> regressors;  // the hypothesis' linear regressors X (raw)
   Vec signal_theta;             // the accepted signals' coefficients in the joint fit
 };
@@ -68,6 +70,9 @@ struct Candidate {
   double lr = 0.0;        // sum over outputs of n_fit ln(before / after), whitened
   double z_hold = 0.0;    // projection test on the held-out part
   double hold_gain = 0.0; // sum over outputs of ln(before / after), held-out whitened variance
+  // The hypothesis fitted jointly with an AR(3) change of the disturbance
+  // model, against that change alone: what it explains beyond a wrong N.
+  double lr_beyond_noise = 0.0;
   double bic(double log_n) const;  // lr - params ln n
 };
 
@@ -76,8 +81,11 @@ struct Candidate {
 OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std::vector<Vec>& X);
 // -sum n ln(var): the objective to minimise over nonlinear parameters.
 double objective(const Context& cx, const std::vector<OutputFit>& fits);
-// Fills lr and z_hold.
+// Fills lr, z_hold, hold_gain and lr_beyond_noise.
 void score(const Context& cx, Candidate& c);
+// Regressors of a change of output j's disturbance model given residual r:
+// r's first three lags (whitened, the lags of the whitened residual: AR(3)).
+std::vector<Vec> noise_change_regressors(const Vec& r);
 // A scored candidate of the given physics from its per-output fits.
 Candidate make_candidate(const Context& cx, std::string physics, std::vector<Channel> channels,
                          std::vector<OutputFit> fits, int params);

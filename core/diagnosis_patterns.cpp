@@ -141,31 +141,14 @@ RowPrediction row_prediction(const Context& cx, std::size_t j) {
 // which per-input u^2 terms cannot say when the inputs move together in
 // closed loop. Over several outputs it is one candidate, so that it is
 // weighed as one explanation against the per-input ones.
-// Under feedback G_M u mirrors the disturbance the controller rejects, so
-// its square can take up a disturbance model that the whitener has wrong.
-// The level gain must therefore still explain the residual significantly
-// when fitted jointly with a change of the disturbance model (as the sensor
-// hypothesis is checked);
-// otherwise it is left to the disturbance-model step.
 void level_gain(const Context& cx, const std::vector<std::size_t>& js, std::vector<Candidate>& out) {
-  std::vector<OutputFit> fits, noise_only, joint;
+  std::vector<OutputFit> fits;
   std::vector<Channel> cs;
   for (std::size_t j : js) {
     const RowPrediction row = row_prediction(cx, j);
-    const Vec square = row.total.cwiseProduct(row.total);
-    const OutputState& o = cx.out[j];
-    // Lags of the residual, whitened, are lags of the whitened residual: an
-    // AR(3) change of the disturbance model, the disturbance-model step's own.
-    const Vec& r = o.signals.empty() ? o.d : o.base;
-    std::vector<Vec> previous{shifted(r, 1), shifted(r, 2), shifted(r, 3)};
-    fits.push_back(fit_output(cx, j, Vec(), {square}));
-    noise_only.push_back(fit_output(cx, j, Vec(), previous));
-    previous.push_back(square);
-    joint.push_back(fit_output(cx, j, Vec(), previous));
+    fits.push_back(fit_output(cx, j, Vec(), {row.total.cwiseProduct(row.total)}));
     cs.insert(cs.end(), row.channels.begin(), row.channels.end());
   }
-  const double lr_given_noise = objective(cx, noise_only) - objective(cx, joint);
-  if (lr_given_noise < chi_square_quantile_upper(cx.settings.alpha, static_cast<double>(js.size()))) return;
   const auto first = static_cast<std::size_t>(cs[0].input.value());
   Candidate c = make_candidate(cx, "nonlinear_gain", cs, fits, static_cast<int>(js.size()));
   c.finding.nominal = *cx.channel(js[0], first);

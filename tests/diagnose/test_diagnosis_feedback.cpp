@@ -1,7 +1,12 @@
-// The diagnosis library on a 2x2 plant under decentralised PI control: a
-// gain that moves with each output's level (a process run away from the
-// point its model was linearised at) is named on every channel at once,
-// although the inputs move together.
+// The diagnosis library on a 2x2 plant under decentralised PI control, where
+// feedback makes the inputs move together and with the disturbances:
+// * a gain that moves with each output's level (a process run away from the
+//   point its model was linearised at) is named on every channel at once;
+// * a changed disturbance model is named as such, and no process change
+//   rides on it: G_M u mirrors the disturbance the controller rejects, so a
+//   correction built from it can take up a noise model the whitener has
+//   wrong, and every process hypothesis must explain the residual beyond an
+//   AR(3) change of that model.
 #include <cstddef>
 #include <random>
 #include <string>
@@ -85,7 +90,7 @@ bool names(const dg::Finding& f, std::size_t output, std::size_t input) {
   return false;
 }
 
-TEST(DiagnosisLevelGain, GainThatMovesWithTheLevelsIsOneFindingOnEveryChannel) {
+TEST(DiagnosisFeedback, GainThatMovesWithTheLevelsIsOneFindingOnEveryChannel) {
   for (unsigned seed : {1u, 2u, 3u}) {
     const dg::Result r = dg::diagnose(closed_loop(Plant{0.08, kPole}, seed));
     const std::string what = "seed " + std::to_string(seed) + ": " + describe(r);
@@ -96,6 +101,17 @@ TEST(DiagnosisLevelGain, GainThatMovesWithTheLevelsIsOneFindingOnEveryChannel) {
       for (std::size_t i = 0; i < 2; ++i) EXPECT_TRUE(names(f, j, i)) << what << " misses y" << j + 1 << " <- u" << i + 1;
     EXPECT_NEAR(f.parameters.at("gain_slope_per_unit_y1"), 0.08, 0.02) << what;
     EXPECT_LT(f.fit.holdout_variance_after, f.fit.holdout_variance_before) << what;
+  }
+}
+
+TEST(DiagnosisFeedback, ChangedDisturbanceModelIsNoProcessChange) {
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    const dg::Result r = dg::diagnose(closed_loop(Plant{0.0, 0.93}, seed));
+    const std::string what = "seed " + std::to_string(seed) + ": " + describe(r);
+    for (const auto& f : r.findings)
+      for (const auto& c : f.channels) EXPECT_FALSE(c.input.has_value()) << what;
+    ASSERT_FALSE(r.findings.empty()) << what;
+    EXPECT_EQ(r.findings.front().physics, "disturbance_model") << what;
   }
 }
 
