@@ -360,6 +360,15 @@ bool passes(const Candidate& c, const Settings& s, double family) {
          c.hold_gain > 0.0 && (c.finding.signal || c.lr_beyond_noise >= chi_square_quantile_upper(s.alpha, c.params));
 }
 
+// Which of the candidates that pass is taken: BIC on the fit part plus the
+// log-likelihood gain on the held-out part, which the fit never saw (so it
+// needs no penalty). Two hypotheses that fit the fit part alike (a slower
+// channel and a smaller gain look alike where the inputs move slowly) are
+// told apart by the data that judged neither.
+double selection_score(const Context& cx, const Candidate& c, double log_n) {
+  return c.bic(log_n) + static_cast<double>(cx.seg.hold_samples()) * c.hold_gain;
+}
+
 // The fit block: one-step prediction-error variances (the whitened residual
 // the fit minimises), summed over the finding's outputs. The raw residual's
 // variance is no measure of fit in closed loop (feedback correlates dG u
@@ -471,11 +480,12 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
         for (const auto& ch : c.finding.channels)
           m += problem.outputs[ch.output] + "<-" + (ch.input ? problem.inputs[*ch.input] : c.finding.signal.value_or("-")) + " ";
         m += "] lr " + fmt(c.lr, 4) + " (limit " + fmt(chi_square_quantile_upper(fit_level(settings, family), c.params), 3) +
-             ") z_hold " + fmt(c.z_hold, 3) + " bic " + fmt(c.bic(log_n), 4) + ": " + c.finding.summary;
+             ") z_hold " + fmt(c.z_hold, 3) + " bic " + fmt(c.bic(log_n), 4) + " selection " +
+             fmt(selection_score(cx, c, log_n), 4) + ": " + c.finding.summary;
         progress(m.c_str());
       }
       if (!passes(c, settings, family) || (signal_first && !c.finding.signal)) continue;
-      const double bic = c.bic(log_n);
+      const double bic = selection_score(cx, c, log_n);
       if (bic > best_bic) {
         best_bic = bic;
         best = &c;
