@@ -396,26 +396,42 @@ void disturbance_models(Context& cx, const std::vector<bool>& explained, Result&
   for (std::size_t j = 0; j < cx.n_out(); ++j) {
     if (explained[j] || j >= cx.problem.noise.size() || !cx.problem.noise[j]) continue;
     const OutputState& o = cx.out[j];
-    const int kmax = 3;
-    const double limit_alpha = fit_level(cx.settings, static_cast<double>(kmax * cx.n_out()));
+    // Corrections C = num / den of the whitened residual N^-1 d (the new
+    // disturbance model is N / C): AR(1..3), and ARMA(1,1). A first-order N
+    // whose pole moved leaves N^-1 d = (1 - p q^-1) / (1 - p' q^-1) a, a pole
+    // and zero that nearly cancel: low-order AR fits take it up poorly, the
+    // ARMA(1,1) exactly (den pole on a grid, num by least squares).
+    std::vector<DiscreteTf> corrections;
+    for (int k = 1; k <= 3; ++k) corrections.push_back(DiscreteTf{fit_ar(o.wd, cx.seg.fit, k), {1.0}, 0});
+    const auto arma = [&](double b) {
+      const Vec v = simulate(DiscreteTf{{1.0}, {1.0, -b}, 0}, o.wd);
+      return DiscreteTf{fit_ar(v, cx.seg.fit, 1), {1.0, -b}, 0};
+    };
+    std::vector<double> poles;
+    for (int k = -6; k <= 14; ++k) poles.push_back(k < 0 ? 0.15 * k : 1.0 - std::pow(0.7, k + 1));
+    const double b = minimise_on_grid(poles, [&](double v) {
+      return least_squares(simulate(arma(v), o.wd), {}, cx.seg).fit_var;
+    });
+    corrections.push_back(arma(b));
+    const double limit_alpha = fit_level(cx.settings, static_cast<double>(corrections.size() * cx.n_out()));
     std::optional<Candidate> best;
-    std::vector<double> best_ar;
-    for (int k = 1; k <= kmax; ++k) {
-      const std::vector<double> a = fit_ar(o.wd, cx.seg.fit, k);
-      const Vec e = simulate(DiscreteTf{a, {1.0}, 0}, o.wd);
-      const LinearFit f = least_squares(e, {}, cx.seg);
+    DiscreteTf best_correction;
+    for (const DiscreteTf& correction : corrections) {
+      const int params = static_cast<int>(correction.den.size() > 1 ? 2 : correction.num.size() - 1);
+      const LinearFit f = least_squares(simulate(correction, o.wd), {}, cx.seg);
       Candidate c;
       OutputFit of;
       of.output = j;
       of.correction = Vec::Zero(o.d.size());
       of.fit = f;
       c.fits.push_back(std::move(of));
-      c.params = k;
+      c.params = params;
       score(cx, c);
-      if (c.lr < chi_square_quantile_upper(limit_alpha, k) || c.z_hold < cx.settings.holdout_z || c.hold_gain <= 0.0) continue;
+      if (c.lr < chi_square_quantile_upper(limit_alpha, params) || c.z_hold < cx.settings.holdout_z || c.hold_gain <= 0.0)
+        continue;
       if (!best || c.bic(std::log(static_cast<double>(n_fit))) > best->bic(std::log(static_cast<double>(n_fit)))) {
         best = std::move(c);
-        best_ar = a;
+        best_correction = correction;
       }
     }
     if (!best) continue;
@@ -425,7 +441,8 @@ void disturbance_models(Context& cx, const std::vector<bool>& explained, Result&
     const DiscreteTf& nn = *cx.problem.noise[j];
     f.nominal = nn;
     DiscreteTf fitted = nn;
-    fitted.den = poly_mul(nn.den, best_ar);
+    fitted.num = poly_mul(nn.num, best_correction.den);
+    fitted.den = poly_mul(nn.den, best_correction.num);
     f.fitted = fitted;
     const double a_var = best->fits[0].fit.fit_var;
     f.parameters["variance"] = a_var;
@@ -433,7 +450,10 @@ void disturbance_models(Context& cx, const std::vector<bool>& explained, Result&
     f.params = best->params;
     f.summary = "no input or recorded signal explains " + cx.problem.outputs[j] +
                 "'s residual, but its one-step prediction error is " + fmt(100.0 * (1.0 - a_var / o.fit_var), 2) +
-                " % smaller with a changed disturbance model (AR order " + std::to_string(best->params) + " on N^-1 d)";
+                " % smaller with a changed disturbance model (" +
+                (best_correction.den.size() > 1 ? std::string("ARMA(1,1)")
+                                                 : "AR order " + std::to_string(best->params)) +
+                " on N^-1 d)";
     // Fit numbers: one-step prediction-error variances (the process model is unchanged).
     f.fit.residual_variance_before = o.fit_var;
     f.fit.residual_variance_after = a_var;
