@@ -493,7 +493,7 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
     bool signal_first = false;
     for (const auto& c : cands) signal_first = signal_first || (c.finding.signal && passes(c, settings, family));
     const Candidate* best = nullptr;
-    double best_bic = -std::numeric_limits<double>::infinity();
+    double best_score = -std::numeric_limits<double>::infinity();
     for (const auto& c : cands) {
       if (settings.verbose && progress) {
         std::string m = "  candidate " + c.finding.physics + " [";
@@ -505,9 +505,9 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
         progress(m.c_str());
       }
       if (!passes(c, settings, family) || (signal_first && !c.finding.signal)) continue;
-      const double bic = selection_score(cx, c, log_n);
-      if (bic > best_bic) {
-        best_bic = bic;
+      const double score_c = selection_score(cx, c, log_n);
+      if (score_c > best_score) {
+        best_score = score_c;
         best = &c;
       }
     }
