@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <exception>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "config/plant_loader.hpp"
@@ -27,7 +28,9 @@ constexpr const char* kUsage =
     "options:\n"
     "  --scenario NAME  which scenario (--list shows them)\n"
     "  --plant FILE     the nominal model (default: the scenario's file under config/, looked up\n"
-    "                   in $MPM_CONFIG_DIR, the source tree and the install dir, else built in)\n"
+    "                   in $MPM_CONFIG_DIR, the source tree and the install dir, else built in);\n"
+    "                   required by plant-nominal, which fits any plant: MPC horizons, weights and\n"
+    "                   limits, setpoint steps and warm-up derived from the model, noise from its file\n"
     "  --samples N      samples to record (default 3000)\n"
     "  --seed S         random seed of noise and setpoint changes (default 1); same seed, same run\n"
     "  --edit SPEC      make the plant differ from the model (repeatable; names as in the plant file):\n"
@@ -45,7 +48,10 @@ constexpr const char* kUsage =
     "  --list           list the scenarios and exit\n";
 
 void list_scenarios() {
-  for (const auto& s : sim::scenarios()) std::printf("  %-30s %s [%s]\n", s.name.c_str(), s.summary.c_str(), s.plant_file.c_str());
+  for (const auto& s : sim::scenarios()) {
+    const std::string plant = s.plant_file.empty() ? "--plant FILE" : s.plant_file;
+    std::printf("  %-30s %s [%s]\n", s.name.c_str(), s.summary.c_str(), plant.c_str());
+  }
 }
 
 std::uint64_t parse_seed(const Args& args) {
@@ -73,9 +79,8 @@ int usage_error(const std::string& what) {
 
 // The scenario's loop with the --edit specs applied to its plant; the names
 // are the plant file's, so this runs once the plant is loaded.
-sim::LoopConfig edited_loop(const sim::Scenario& scenario, const PlantModel& model,
-                            const std::vector<std::string>& texts, std::vector<sim::EditSpec>& specs) {
-  sim::LoopConfig loop = scenario.loop;
+sim::LoopConfig edited_loop(sim::LoopConfig loop, const PlantModel& model, const std::vector<std::string>& texts,
+                            std::vector<sim::EditSpec>& specs) {
   for (const auto& text : texts) specs.push_back(sim::parse_edit(text, model.inputs, model.outputs));
   sim::apply_edits(specs, loop.plant);
   return loop;
@@ -103,8 +108,10 @@ int run_simulate(int argc, char** argv) {
     seed = parse_seed(args);
     plant_path = args.get("plant");
     edit_texts = args.all("edit");
-    if (!sim::find_scenario(scenario_name))
-      throw UsageError("unknown scenario '" + scenario_name + "' (mpm simulate --list shows them)");
+    const sim::Scenario* scenario = sim::find_scenario(scenario_name);
+    if (!scenario) throw UsageError("unknown scenario '" + scenario_name + "' (mpm simulate --list shows them)");
+    if (scenario->plant_file.empty() && !plant_path)
+      throw UsageError("scenario " + scenario_name + " needs --plant FILE: it is tuned from the plant file given");
   } catch (const UsageError& e) {
     return usage_error(e.what());
   }
@@ -113,9 +120,9 @@ int run_simulate(int argc, char** argv) {
     sim::ResolvedPlant plant = plant_path ? sim::ResolvedPlant{config::load_plant(*plant_path), *plant_path}
                                           : sim::default_plant(scenario);
     std::vector<sim::EditSpec> edits;
-    sim::LoopConfig loop_config;
+    sim::LoopConfig loop_config = sim::scenario_loop(scenario, plant.model);
     try {
-      loop_config = edited_loop(scenario, plant.model, edit_texts, edits);
+      loop_config = edited_loop(std::move(loop_config), plant.model, edit_texts, edits);
     } catch (const std::invalid_argument& e) {
       return usage_error(std::string("--edit ") + e.what());
     }

@@ -9,6 +9,7 @@
 
 #include "config/plant_loader.hpp"
 #include "sim/builtin_plants.hpp"
+#include "sim/plant_tuning.hpp"
 
 namespace mpm::sim {
 namespace {
@@ -164,7 +165,7 @@ std::vector<Scenario> make_scenarios() {
   saturation.upper_limit = 0.9;
   InputEdit deadband{"u2"};
   deadband.deadband_width = 0.5;
-  return {
+  std::vector<Scenario> all = {
       {"wood-berry-nominal", "Wood-Berry column, plant = model (paper Sec. 4.1.1)", wb, wood_berry()},
       {"wood-berry-g21-gain", "Wood-Berry, G21 gain x 1.2 (paper Sec. 4.1.2)", wb,
        wood_berry({gain("y2", "u1", 1.2)})},
@@ -200,6 +201,15 @@ std::vector<Scenario> make_scenarios() {
       {"quad-tank-g32-integrator", "4x4, G32 gains an integrator: the loop goes unstable (paper Sec. 4.2.4)", q4,
        quad_tank_4x4({with_integrator("y3", "u2")})},
   };
+  // No plant file of its own: horizons, weights, limits and setpoints come
+  // from whatever plant --plant gives (sim/plant_tuning.*).
+  Scenario any_plant{"plant-nominal",
+                     "any plant file: MPC tuned from the model, random setpoint steps; plant = model unless --edit "
+                     "says otherwise",
+                     "", {}};
+  any_plant.tune = &tuned_loop;
+  all.push_back(std::move(any_plant));
+  return all;
 }
 
 }  // namespace
@@ -227,7 +237,13 @@ std::vector<std::string> plant_search_path() {
   return dirs;
 }
 
+LoopConfig scenario_loop(const Scenario& scenario, const PlantModel& model) {
+  return scenario.tune ? scenario.tune(model) : scenario.loop;
+}
+
 ResolvedPlant default_plant(const Scenario& scenario) {
+  if (scenario.plant_file.empty())
+    throw config::ConfigError("scenario " + scenario.name + " has no default plant: give the plant file (--plant)");
   for (const auto& dir : plant_search_path()) {
     const std::filesystem::path file = std::filesystem::path(dir) / scenario.plant_file;
     std::error_code ec;

@@ -1,0 +1,116 @@
+// `mpm simulate --scenario plant-nominal --plant FILE` end to end: it needs
+// --plant (usage error otherwise), runs on the 2x2, 3x3 and 4x4 example
+// plants with their columns, equals the loop tuned in-process, and takes
+// --edit like every scenario.
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "config/plant_loader.hpp"
+#include "sim/closed_loop.hpp"
+#include "sim/scenarios.hpp"
+#include "support/cli.hpp"
+
+namespace {
+
+using mpm::test::kMpm;
+using mpm::test::read_file;
+
+const std::string kConfig = std::string(MPM_SOURCE_DIR) + "/config/";
+
+// Per test: ctest runs the tests of this file in parallel processes.
+std::string tmp_path(const std::string& name) {
+  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  return mpm::test::tmp_path("mpm_simplant_" + test + "_", name);
+}
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+CliRun simulate(const std::string& args) {
+  const std::string out = tmp_path("stdout.txt"), err = tmp_path("stderr.txt");
+  const int status = std::system((kMpm + " simulate " + args + " >" + out + " 2>" + err).c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(out), read_file(err)};
+}
+
+// plant-nominal's recording on config/<plant> (seed 3, 400 samples) plus `edits`.
+std::string recording(const std::string& name, const std::string& plant, const std::string& edits = "",
+                      std::string* wrote = nullptr) {
+  const std::string csv = tmp_path(name + ".csv");
+  std::remove(csv.c_str());
+  const CliRun r = simulate("--scenario plant-nominal --plant " + kConfig + plant + " --samples 400 --seed 3 " + edits +
+                            " --out " + csv);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  if (wrote) *wrote = r.out;
+  return read_file(csv);
+}
+
+std::string header(const std::string& csv) { return csv.substr(0, csv.find('\n')); }
+
+TEST(SimulatePlantCli, WithoutPlantIsAUsageError) {
+  const std::string csv = tmp_path("refused.csv");
+  std::remove(csv.c_str());
+  const CliRun r = simulate("--scenario plant-nominal --out " + csv);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("plant-nominal needs --plant FILE"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("usage: mpm simulate"), std::string::npos) << r.err;
+  EXPECT_TRUE(read_file(csv).empty());  // nothing written, no default plant tried
+}
+
+TEST(SimulatePlantCli, RunsOnEveryExamplePlantWithItsColumns) {
+  for (const auto& [plant, columns] : std::initializer_list<std::pair<const char*, const char*>>{
+           {"wood-berry.yaml", "t,u1,u2,y1,y2,r_y1,r_y2"},
+           {"three-by-three.yaml", "t,u1,u2,u3,y1,y2,y3,r_y1,r_y2,r_y3"},
+           {"quad-tank-4x4.yaml", "t,u1,u2,u3,u4,y1,y2,y3,y4,r_y1,r_y2,r_y3,r_y4"}}) {
+    std::string wrote;
+    const std::string csv = recording(std::string("run_") + plant, plant, "", &wrote);
+    EXPECT_EQ(header(csv), columns) << plant;
+    EXPECT_NE(wrote.find("400 samples of plant-nominal (plant " + kConfig + plant), std::string::npos) << wrote;
+    EXPECT_NE(wrote.find("input limits active at 0 samples"), std::string::npos) << wrote;
+  }
+}
+
+// The command runs the loop tuned from the file's model, nothing else.
+TEST(SimulatePlantCli, EqualsTheLoopTunedInProcess) {
+  const std::string cli = recording("cli", "three-by-three.yaml");
+  const mpm::PlantModel model = mpm::config::load_plant(kConfig + "three-by-three.yaml");
+  mpm::sim::ClosedLoop loop(model, mpm::sim::scenario_loop(*mpm::sim::find_scenario("plant-nominal"), model), 3);
+  const std::string coded = tmp_path("coded.csv");
+  mpm::config::write_recording(coded, mpm::sim::simulate(loop, 400));
+  ASSERT_GT(cli.size(), 1000u);
+  EXPECT_EQ(cli, read_file(coded));
+  EXPECT_EQ(cli, recording("cli_again", "three-by-three.yaml"));  // same seed, same run
+}
+
+TEST(SimulatePlantCli, EditChangesTheRunAndIsReported) {
+  const std::string nominal = recording("nominal", "three-by-three.yaml");
+  std::string wrote;
+  const std::string edited = recording("edited", "three-by-three.yaml", "--edit y2.u1.delay=2", &wrote);
+  EXPECT_EQ(header(edited), header(nominal));
+  EXPECT_NE(edited, nominal);
+  EXPECT_NE(wrote.find("plant-nominal with --edit y2.u1.delay=2"), std::string::npos) << wrote;
+  // A name the plant file does not have is refused as for any scenario.
+  const CliRun bad = simulate("--scenario plant-nominal --plant " + kConfig +
+                              "three-by-three.yaml --edit y4.u1.gain=2 --out " + tmp_path("bad.csv"));
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("unknown output 'y4' (outputs: y1, y2, y3)"), std::string::npos) << bad.err;
+}
+
+TEST(SimulatePlantCli, ListAndHelpNameIt) {
+  const CliRun list = simulate("--list");
+  EXPECT_EQ(list.exit_code, 0);
+  const auto line = list.out.find("plant-nominal");
+  ASSERT_NE(line, std::string::npos) << list.out;
+  EXPECT_NE(list.out.find("[--plant FILE]", line), std::string::npos) << list.out;
+  const CliRun help = simulate("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("required by plant-nominal"), std::string::npos) << help.out;
+}
+
+}  // namespace
