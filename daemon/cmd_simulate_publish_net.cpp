@@ -99,8 +99,11 @@ int run(int argc, char** argv) {
     }
     net = net_cli::read(args);
     o.scenario = args.required("scenario");
-    if (!sim::find_scenario(o.scenario)) throw UsageError("unknown scenario '" + o.scenario + "' (mpm simulate --list)");
+    const sim::Scenario* scenario = sim::find_scenario(o.scenario);
+    if (!scenario) throw UsageError("unknown scenario '" + o.scenario + "' (mpm simulate --list)");
     o.plant = args.get("plant");
+    if (scenario->plant_file.empty() && !o.plant)
+      throw UsageError("scenario " + o.scenario + " needs --plant FILE: it is tuned from the plant file given");
     o.controller = args.get("controller").value_or(net.daemon ? net.daemon->controller_id : "");
     o.samples = args.integer("samples", 0);
     o.seed = static_cast<unsigned long>(args.integer("seed", 1));
@@ -119,7 +122,7 @@ int run(int argc, char** argv) {
     const sim::ResolvedPlant plant =
         o.plant ? sim::ResolvedPlant{config::load_plant(*o.plant), *o.plant} : sim::default_plant(scenario);
     if (o.controller.empty()) o.controller = plant.model.name;
-    sim::ClosedLoop loop(plant.model, scenario.loop, o.seed);
+    sim::ClosedLoop loop(plant.model, sim::scenario_loop(scenario, plant.model), o.seed);
     std::string error;
     auto t = transport::create(net.transport, error);
     if (!t) throw std::runtime_error(error);

@@ -375,6 +375,28 @@ TEST_P(LoopbackTest, SimulateLivePublishesTheClosedLoop) {
   EXPECT_EQ(s.nan_samples, 0);
 }
 
+// The loop tuned from a plant file (plant-nominal) drives mpmd the same way:
+// simulate-live takes the tuned loop, not a fixed default.
+TEST_P(LoopbackTest, SimulateLivePublishesTheLoopTunedFromThePlantFile) {
+  auto t = make_transport();
+  ASSERT_TRUE(t);
+  Observer obs(*t);
+  const std::string config = write_config("mpmd.yaml", "wood-berry");
+  auto run = start_and_wait(*this, [&] { return start_mpmd(config); }, *t, obs, "wood-berry", 0);
+  ASSERT_TRUE(run.up);
+  ChildProcess live({kMpm, "simulate-live", "--scenario", "plant-nominal", "--plant",
+                     MPM_SOURCE_DIR "/config/wood-berry.yaml", "--config", config, "--samples", "300", "--rate", "2000"},
+                    dir().file("live.out"), dir().file("live.err"));
+  ASSERT_EQ(live.wait_exit(std::chrono::seconds(40)), 0) << live.stderr_text();
+  EXPECT_NE(live.stdout_text().find("published 300 samples of plant-nominal"), std::string::npos) << live.stdout_text();
+  ASSERT_TRUE(obs.wait_status("wood-berry", [](const msg::Status& s) { return s.samples_seen == 300; }))
+      << obs.status("wood-berry")->samples_seen;
+  const msg::Status s = *obs.status("wood-berry");
+  EXPECT_EQ(s.malformed, 0);
+  EXPECT_EQ(s.gaps, 0);
+  EXPECT_EQ(s.nan_samples, 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Transports, LoopbackTest, ::testing::Values(transport::Kind::kLcm, transport::Kind::kDds),
                          kind_name);
 

@@ -63,6 +63,17 @@ TEST(SimulatePlantCli, WithoutPlantIsAUsageError) {
   EXPECT_TRUE(read_file(csv).empty());  // nothing written, no default plant tried
 }
 
+// simulate-live builds the same loop, so it refuses the same way (before
+// it opens any transport).
+TEST(SimulatePlantCli, SimulateLiveWithoutPlantIsAUsageError) {
+  const std::string out = tmp_path("live.out"), err = tmp_path("live.err");
+  const int status = std::system(
+      (kMpm + " simulate-live --scenario plant-nominal --publish lcm --samples 5 >" + out + " 2>" + err).c_str());
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
+  EXPECT_NE(read_file(err).find("plant-nominal needs --plant FILE"), std::string::npos) << read_file(err);
+  EXPECT_EQ(read_file(out).find("published"), std::string::npos) << read_file(out);
+}
+
 TEST(SimulatePlantCli, RunsOnEveryExamplePlantWithItsColumns) {
   for (const auto& [plant, columns] : std::initializer_list<std::pair<const char*, const char*>>{
            {"wood-berry.yaml", "t,u1,u2,y1,y2,r_y1,r_y2"},
