@@ -20,7 +20,8 @@ namespace mpm {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: mpm simulate --scenario NAME [--plant PLANT.yaml] [--samples N] [--seed S] [--edit SPEC]... --out RUN.csv\n"
+    "usage: mpm simulate --scenario NAME [--plant PLANT.yaml] [--samples N] [--seed S] [--edit SPEC]...\n"
+    "                    [--move-weight-scale X] --out RUN.csv\n"
     "       mpm simulate --list\n"
     "  Runs the closed loop of the scenario (DMC with IMC bias correction on the plant file's\n"
     "  model; the plant differs from it as the scenario says, plus any --edit) and writes t,\n"
@@ -44,8 +45,24 @@ constexpr const char* kUsage =
     "                   e.g. --edit y2.u1.gain=0.8 --edit u2.actuator_lag=0.45 --edit y1.sensor_lag=0.5\n"
     "                   Edits of one channel/input/output combine; a key the scenario already sets\n"
     "                   there is replaced, its other keys stay. Bad names, keys or values: exit 2.\n"
+    "  --move-weight-scale X   multiply the controller's move weights by X > 0 (default 1):\n"
+    "                   below 1 a tighter controller, whose inputs answer the noise more (more\n"
+    "                   excitation), above 1 a calmer one\n"
     "  --out FILE       where to write the recording CSV\n"
     "  --list           list the scenarios and exit\n";
+
+// The scenario's move weights (empty: all 1) times `scale`.
+void scale_move_weights(sim::LoopConfig& loop, const PlantModel& model, double scale) {
+  auto& weights = loop.mpc.move_weights;
+  if (weights.empty()) weights.assign(model.inputs.size(), 1.0);
+  for (double& w : weights) w *= scale;
+}
+
+std::string format_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
 
 void list_scenarios() {
   for (const auto& s : sim::scenarios()) {
@@ -92,8 +109,10 @@ int run_simulate(int argc, char** argv) {
   std::size_t samples = 0;
   std::uint64_t seed = 0;
   std::optional<std::string> plant_path;
+  double move_weight_scale = 1.0;
   try {
-    const Args args(argc, argv, {"plant", "scenario", "samples", "seed", "out", "edit"}, {"list", "help"});
+    const Args args(argc, argv, {"plant", "scenario", "samples", "seed", "out", "edit", "move-weight-scale"},
+                    {"list", "help"});
     if (args.flag("help")) {
       std::fputs(kUsage, stdout);
       return 0;
@@ -108,6 +127,9 @@ int run_simulate(int argc, char** argv) {
     seed = parse_seed(args);
     plant_path = args.get("plant");
     edit_texts = args.all("edit");
+    move_weight_scale = args.number("move-weight-scale", 1.0);
+    if (!(move_weight_scale > 0.0 && move_weight_scale <= 1e6))
+      throw UsageError("--move-weight-scale: expected a number in (0, 1e6]");
     const sim::Scenario* scenario = sim::find_scenario(scenario_name);
     if (!scenario) throw UsageError("unknown scenario '" + scenario_name + "' (mpm simulate --list shows them)");
     if (scenario->plant_file.empty() && !plant_path)
@@ -126,7 +148,9 @@ int run_simulate(int argc, char** argv) {
     } catch (const std::invalid_argument& e) {
       return usage_error(std::string("--edit ") + e.what());
     }
-    const std::string what = edits.empty() ? scenario.name : scenario.name + " with --edit " + sim::describe(edits);
+    scale_move_weights(loop_config, plant.model, move_weight_scale);
+    std::string what = edits.empty() ? scenario.name : scenario.name + " with --edit " + sim::describe(edits);
+    if (move_weight_scale != 1.0) what += " (move weights x " + format_number(move_weight_scale) + ")";
     sim::ClosedLoop loop = [&] {
       try {
         return sim::ClosedLoop(plant.model, loop_config, seed);

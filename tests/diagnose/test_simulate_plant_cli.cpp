@@ -4,6 +4,7 @@
 // --edit like every scenario.
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -111,6 +112,40 @@ TEST(SimulatePlantCli, EditChangesTheRunAndIsReported) {
                               "three-by-three.yaml --edit y4.u1.gain=2 --out " + tmp_path("bad.csv"));
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("unknown output 'y4' (outputs: y1, y2, y3)"), std::string::npos) << bad.err;
+}
+
+// Mean |u(k) - u(k-1)| of the first input column (column 1 after t).
+double mean_input_move(const std::string& csv) {
+  std::size_t at = csv.find('\n') + 1;
+  double previous = 0.0, sum = 0.0;
+  int rows = 0;
+  while (at < csv.size()) {
+    const std::size_t comma = csv.find(',', at);
+    const double u = std::strtod(csv.c_str() + comma + 1, nullptr);
+    if (rows > 0) sum += std::abs(u - previous);
+    previous = u;
+    ++rows;
+    at = csv.find('\n', at);
+    if (at == std::string::npos) break;
+    ++at;
+  }
+  return rows > 1 ? sum / (rows - 1) : 0.0;
+}
+
+// A tighter controller answers the noise with more input movement: the
+// excitation a mismatch is detected by.
+TEST(SimulatePlantCli, MoveWeightScaleSetsHowBusyTheInputsAre) {
+  const std::string calm = recording("calm", "three-by-three.yaml");
+  std::string wrote;
+  const std::string tight = recording("tight", "three-by-three.yaml", "--move-weight-scale 0.001", &wrote);
+  EXPECT_GT(mean_input_move(tight), 3.0 * mean_input_move(calm));
+  EXPECT_NE(wrote.find("(move weights x 0.001)"), std::string::npos) << wrote;
+  for (const char* bad : {"0", "-1", "nan", "abc"}) {
+    const CliRun r = simulate("--scenario plant-nominal --plant " + kConfig + "three-by-three.yaml --move-weight-scale " +
+                              bad + " --out " + tmp_path("bad.csv"));
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.err;
+    EXPECT_NE(r.err.find("--move-weight-scale"), std::string::npos) << bad << ": " << r.err;
+  }
 }
 
 TEST(SimulatePlantCli, ListAndHelpNameIt) {
