@@ -14,6 +14,13 @@ namespace mpm::diagnosis {
 
 double Candidate::bic(double log_n) const { return lr - params * log_n; }
 
+int Context::response_delay(std::size_t j, std::size_t i) const {
+  const DiscreteTf& g = *channel(j, i);
+  int leading = 0;
+  while (leading < static_cast<int>(g.num.size()) && g.num[static_cast<std::size_t>(leading)] == 0.0) ++leading;
+  return g.delay + leading;
+}
+
 OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std::vector<Vec>& X) {
   const OutputState& o = cx.out[j];
   OutputFit f;
@@ -263,6 +270,10 @@ Context prepare(const Problem& p, const Settings& s) {
     const double ref = std::max(1.0, u.cwiseAbs().maxCoeff()) * 1e-6;
     cx.excited[i] = sd > ref;
   }
+  cx.min_input_delay = 1;
+  for (std::size_t j = 0; j < p.outputs.size(); ++j)
+    for (std::size_t i = 0; i < p.inputs.size(); ++i)
+      if (cx.has_channel(j, i) && cx.response_delay(j, i) == 0) cx.min_input_delay = 0;
   cx.gu.resize(p.outputs.size() * p.inputs.size());
   for (std::size_t j = 0; j < p.outputs.size(); ++j)
     for (std::size_t i = 0; i < p.inputs.size(); ++i)

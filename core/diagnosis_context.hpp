@@ -42,11 +42,18 @@ struct Context {
   std::vector<Vec> gu;           // per channel (output major): G_ji du_i, empty without a channel
   Eigen::MatrixXd extra;         // extra columns, deviation from their fit mean, held
   std::vector<bool> excited;     // per input: moves on the fit part
+  // The fewest samples any hypothesis may take an input to act: 1 when every
+  // channel of the model is strictly proper (the recording's timing then
+  // has u(k) act after y(k) is read, and a same-sample response in the data
+  // can only be the controller's: u(k) is computed from y(k)), else 0.
+  int min_input_delay = 0;
   std::size_t n_in() const { return problem.inputs.size(); }
   std::size_t n_out() const { return problem.outputs.size(); }
   const std::optional<DiscreteTf>& channel(std::size_t j, std::size_t i) const {
     return problem.nominal[j * n_in() + i];
   }
+  // Samples before channel (j, i) responds: its delay plus num's leading zeros.
+  int response_delay(std::size_t j, std::size_t i) const;
   bool has_channel(std::size_t j, std::size_t i) const {
     const auto& c = channel(j, i);
     return c && !c->is_zero();

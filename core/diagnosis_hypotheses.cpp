@@ -1,6 +1,7 @@
 // The structured hypotheses of the diagnosis: each is a change of the nominal
 // model with one to three physical parameters, fitted by prediction-error
 // minimisation of the whitened residual on the fit part of the record.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -44,7 +45,10 @@ void dead_time(const Context& cx, std::size_t j, std::size_t i, std::vector<Cand
   const DiscreteTf& g = *cx.channel(j, i);
   int best = 0;
   double best_obj = std::numeric_limits<double>::infinity();
-  for (int s = -g.delay; s <= cx.settings.max_extra_delay; ++s) {
+  // Shorter down to the model's own delay (never below the recording's
+  // fewest samples an input needs to act), or longer.
+  const int shortest = std::max(-g.delay, cx.min_input_delay - cx.response_delay(j, i));
+  for (int s = shortest; s <= cx.settings.max_extra_delay; ++s) {
     if (s == 0) continue;
     const double o = objective(cx, {fit_output(cx, j, shifted(x, s) - x, {})});
     if (o < best_obj) {
@@ -167,7 +171,7 @@ Fopdt best_fopdt(const Context& cx, std::size_t j, const Vec& x, int min_delay, 
 
 void missing_channel(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
-  const Fopdt f = best_fopdt(cx, j, u, 0, 20);
+  const Fopdt f = best_fopdt(cx, j, u, cx.min_input_delay, 20);
   OutputFit fit = fit_output(cx, j, Vec(), {shifted(simulate(unit_lag(f.pole), u), f.delay)});
   const double k = fit.fit.theta(0);
   Candidate c = make_candidate(cx, "missing_channel", {{j, i}}, {std::move(fit)}, 3);

@@ -1,8 +1,10 @@
 // `mpm diagnose` on simulated recordings with known truth: the report keeps
 // the contract of formats.md section 3 and names the planted mismatch.
 #include <cstdlib>
+#include <fstream>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -43,6 +45,17 @@ std::set<std::string> physics_words(const std::string& report) {
     words.insert(report.substr(at, end - at));
   }
   return words;
+}
+
+// The delay of every "fitted" model in the report.
+std::vector<int> fitted_delays(const std::string& report) {
+  std::vector<int> delays;
+  const std::string key = "\"fitted\": {";
+  for (std::size_t at = report.find(key); at != std::string::npos; at = report.find(key, at + 1)) {
+    const std::size_t end = report.find('}', at), d = report.find("\"delay\": ", at);
+    if (d < end) delays.push_back(std::atoi(report.c_str() + d + 9));
+  }
+  return delays;
 }
 
 bool names_channel(const std::string& report, const std::string& output, const std::string& input) {
@@ -111,6 +124,40 @@ TEST(DiagnoseCli, QuadTankNearItsLinearisationGivesNoFinding) {
   const std::string r = diagnose_scenario("quad-tank-nominal", 33, 4000, kQuadTank);
   EXPECT_NE(r.find("\"mismatch\": false"), std::string::npos) << r;
   EXPECT_TRUE(physics_words(r).empty()) << r;
+}
+
+// The 3x3 example plant with a channel y1 <- u3 its model lacks: simulated
+// from a copy of the file that has it (tight control, as the benchmark's
+// recordings), diagnosed against the file without it. Every channel of the
+// model is strictly proper, so u(k) acts after y(k) is read: a response in
+// the same sample can only be the controller's (u(k) is computed from
+// y(k)), and no finding may claim one (a missing channel or a dead time of 0).
+TEST(DiagnoseCli, MissingChannelIsNamedAndNoFindingRespondsWithinTheSample) {
+  const std::string model = read_file(std::string(MPM_SOURCE_DIR) + "/config/three-by-three.yaml");
+  const std::string anchor = "  - output: y2\n    input: u1\n";
+  const std::size_t at = model.find(anchor);
+  ASSERT_NE(at, std::string::npos);
+  const std::string with_channel = tmp_path("three-by-three-y1u3.yaml");
+  {
+    std::ofstream f(with_channel);
+    f << model.substr(0, at) << "  - output: y1\n    input: u3\n    continuous: {num: [0.3], den: [20, 1], dead_time: 2}\n"
+      << model.substr(at);
+  }
+  for (int seed : {71, 73}) {
+    const std::string csv = tmp_path("y1u3.csv"), out = tmp_path("y1u3.json");
+    ASSERT_EQ(run(kMpm + " simulate --scenario plant-nominal --plant " + with_channel +
+                  " --move-weight-scale 0.001 --seed " + std::to_string(seed) + " --out " + csv),
+              0);
+    ASSERT_EQ(run(kMpm + " diagnose --quiet --plant " + std::string(MPM_SOURCE_DIR) +
+                  "/config/three-by-three.yaml --data " + csv + " --json " + out),
+              0);
+    const std::string r = read_file(out);
+    EXPECT_EQ(physics_words(r), std::set<std::string>{"missing_channel"}) << "seed " << seed << ":\n" << r;
+    EXPECT_TRUE(names_channel(r, "y1", "\"u3\"")) << "seed " << seed;
+    const std::vector<int> delays = fitted_delays(r);
+    EXPECT_FALSE(delays.empty()) << r;
+    for (int d : delays) EXPECT_GE(d, 1) << "seed " << seed << ":\n" << r;
+  }
 }
 
 TEST(DiagnoseCli, ErrorsNameTheFileAndUseExitCodes) {
