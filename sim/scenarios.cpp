@@ -191,6 +191,8 @@ std::vector<Scenario> make_scenarios() {
       {"quad-tank-nominal", "nonlinear quadruple tank near its linearisation point", qt, quad_tank(0.0, 0.3)},
       {"quad-tank-wide-low", "nonlinear quadruple tank run 0.3-1.5 V below the linearisation point", qt,
        quad_tank(-0.9, 0.6)},
+      {"quad-tank-wide-high", "nonlinear quadruple tank run 0.3-1.5 V above the linearisation point", qt,
+       quad_tank(0.9, 0.6)},
       {"quad-tank-sensor-level1", "nonlinear quadruple tank, level1 transmitter lag (pole 0.3)", qt,
        quad_tank_sensor_level1()},
       {"quad-tank-4x4-nominal", "paper's 4x4 tank model, plant = model, Table 8 setpoints", q4, quad_tank_4x4({})},
