@@ -355,49 +355,46 @@ TEST_P(LoopbackTest, ReplayCommandPublishesARecording) {
   EXPECT_GT(s.samples_used, 200);  // all but the settle time and regressor fill
 }
 
-// `mpm simulate-live` runs the closed loop and publishes as the MPC would.
-TEST_P(LoopbackTest, SimulateLivePublishesTheClosedLoop) {
-  auto t = make_transport();
-  ASSERT_TRUE(t);
-  Observer obs(*t);
-  const std::string config = write_config("mpmd.yaml", "wood-berry");
-  auto run = start_and_wait(*this, [&] { return start_mpmd(config); }, *t, obs, "wood-berry", 0);
-  ASSERT_TRUE(run.up);
-  ChildProcess live({kMpm, "simulate-live", "--scenario", "wood-berry-nominal", "--config", config, "--samples", "300",
-                     "--rate", "2000"},
-                    dir().file("live.out"), dir().file("live.err"));
-  ASSERT_EQ(live.wait_exit(std::chrono::seconds(40)), 0) << live.stderr_text();
-  ASSERT_TRUE(obs.wait_status("wood-berry", [](const msg::Status& s) { return s.samples_seen == 300; }))
-      << obs.status("wood-berry")->samples_seen;
-  const msg::Status s = *obs.status("wood-berry");
-  EXPECT_EQ(s.malformed, 0);
-  EXPECT_EQ(s.gaps, 0);
-  EXPECT_EQ(s.nan_samples, 0);
+// `mpm simulate-live` with `scenario_args` runs a closed loop on Wood-Berry
+// and publishes 300 samples as the MPC would; mpmd sees every one, clean.
+class SimulateLiveTest : public LoopbackTest {
+ protected:
+  void expect_simulate_live_drives_mpmd(const std::vector<std::string>& scenario_args) {
+    auto t = make_transport();
+    ASSERT_TRUE(t);
+    Observer obs(*t);
+    const std::string config = write_config("mpmd.yaml", "wood-berry");
+    auto run = start_and_wait(*this, [&] { return start_mpmd(config); }, *t, obs, "wood-berry", 0);
+    ASSERT_TRUE(run.up);
+    std::vector<std::string> args{kMpm, "simulate-live"};
+    args.insert(args.end(), scenario_args.begin(), scenario_args.end());
+    args.insert(args.end(), {"--config", config, "--samples", "300", "--rate", "2000"});
+    ChildProcess live(args, dir().file("live.out"), dir().file("live.err"));
+    ASSERT_EQ(live.wait_exit(std::chrono::seconds(40)), 0) << live.stderr_text();
+    EXPECT_NE(live.stdout_text().find("published 300 samples of " + scenario_args[1]), std::string::npos)
+        << live.stdout_text();
+    ASSERT_TRUE(obs.wait_status("wood-berry", [](const msg::Status& s) { return s.samples_seen == 300; }))
+        << obs.status("wood-berry")->samples_seen;
+    const msg::Status s = *obs.status("wood-berry");
+    EXPECT_EQ(s.malformed, 0);
+    EXPECT_EQ(s.gaps, 0);
+    EXPECT_EQ(s.nan_samples, 0);
+  }
+};
+
+TEST_P(SimulateLiveTest, PublishesTheClosedLoop) {
+  expect_simulate_live_drives_mpmd({"--scenario", "wood-berry-nominal"});
 }
 
 // The loop tuned from a plant file (plant-nominal) drives mpmd the same way:
 // simulate-live takes the tuned loop, not a fixed default.
-TEST_P(LoopbackTest, SimulateLivePublishesTheLoopTunedFromThePlantFile) {
-  auto t = make_transport();
-  ASSERT_TRUE(t);
-  Observer obs(*t);
-  const std::string config = write_config("mpmd.yaml", "wood-berry");
-  auto run = start_and_wait(*this, [&] { return start_mpmd(config); }, *t, obs, "wood-berry", 0);
-  ASSERT_TRUE(run.up);
-  ChildProcess live({kMpm, "simulate-live", "--scenario", "plant-nominal", "--plant",
-                     MPM_SOURCE_DIR "/config/wood-berry.yaml", "--config", config, "--samples", "300", "--rate", "2000"},
-                    dir().file("live.out"), dir().file("live.err"));
-  ASSERT_EQ(live.wait_exit(std::chrono::seconds(40)), 0) << live.stderr_text();
-  EXPECT_NE(live.stdout_text().find("published 300 samples of plant-nominal"), std::string::npos) << live.stdout_text();
-  ASSERT_TRUE(obs.wait_status("wood-berry", [](const msg::Status& s) { return s.samples_seen == 300; }))
-      << obs.status("wood-berry")->samples_seen;
-  const msg::Status s = *obs.status("wood-berry");
-  EXPECT_EQ(s.malformed, 0);
-  EXPECT_EQ(s.gaps, 0);
-  EXPECT_EQ(s.nan_samples, 0);
+TEST_P(SimulateLiveTest, PublishesTheLoopTunedFromThePlantFile) {
+  expect_simulate_live_drives_mpmd({"--scenario", "plant-nominal", "--plant", MPM_SOURCE_DIR "/config/wood-berry.yaml"});
 }
 
 INSTANTIATE_TEST_SUITE_P(Transports, LoopbackTest, ::testing::Values(transport::Kind::kLcm, transport::Kind::kDds),
+                         kind_name);
+INSTANTIATE_TEST_SUITE_P(Transports, SimulateLiveTest, ::testing::Values(transport::Kind::kLcm, transport::Kind::kDds),
                          kind_name);
 
 }  // namespace

@@ -19,23 +19,12 @@ namespace {
 using mpm::test::kMpm;
 using mpm::test::read_file;
 
-// Per test: ctest runs the tests of this file in parallel processes.
-std::string tmp_path(const std::string& name) {
-  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  return mpm::test::tmp_path("mpm_simedit_" + test + "_", name);
-}
+using mpm::test::CliRun;
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
+std::string tmp_path(const std::string& name) { return mpm::test::per_test_tmp_path("mpm_simedit_", name); }
 
 // Runs `mpm simulate ARGS`, capturing its exit code, stdout and stderr.
-CliRun simulate(const std::string& args) {
-  const std::string out = tmp_path("stdout.txt"), err = tmp_path("stderr.txt");
-  const int status = std::system((kMpm + " simulate " + args + " >" + out + " 2>" + err).c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(out), read_file(err)};
-}
+CliRun simulate(const std::string& args) { return mpm::test::run_captured(kMpm + " simulate " + args, "mpm_simedit_"); }
 
 // The recording CSV of `scenario` (seed 3, 400 samples) plus `edits`.
 std::string recording(const std::string& name, const std::string& scenario, const std::string& edits = "") {

@@ -23,22 +23,12 @@ using mpm::test::read_file;
 
 const std::string kConfig = std::string(MPM_SOURCE_DIR) + "/config/";
 
-// Per test: ctest runs the tests of this file in parallel processes.
-std::string tmp_path(const std::string& name) {
-  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  return mpm::test::tmp_path("mpm_simplant_" + test + "_", name);
-}
+using mpm::test::CliRun;
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
+std::string tmp_path(const std::string& name) { return mpm::test::per_test_tmp_path("mpm_simplant_", name); }
 
-CliRun simulate(const std::string& args) {
-  const std::string out = tmp_path("stdout.txt"), err = tmp_path("stderr.txt");
-  const int status = std::system((kMpm + " simulate " + args + " >" + out + " 2>" + err).c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(out), read_file(err)};
-}
+// Runs `mpm simulate ARGS`, capturing its exit code, stdout and stderr.
+CliRun simulate(const std::string& args) { return mpm::test::run_captured(kMpm + " simulate " + args, "mpm_simplant_"); }
 
 // plant-nominal's recording on config/<plant> (seed 3, 400 samples) plus `edits`.
 std::string recording(const std::string& name, const std::string& plant, const std::string& edits = "",
@@ -67,12 +57,11 @@ TEST(SimulatePlantCli, WithoutPlantIsAUsageError) {
 // simulate-live builds the same loop, so it refuses the same way (before
 // it opens any transport).
 TEST(SimulatePlantCli, SimulateLiveWithoutPlantIsAUsageError) {
-  const std::string out = tmp_path("live.out"), err = tmp_path("live.err");
-  const int status = std::system(
-      (kMpm + " simulate-live --scenario plant-nominal --publish lcm --samples 5 >" + out + " 2>" + err).c_str());
-  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 2);
-  EXPECT_NE(read_file(err).find("plant-nominal needs --plant FILE"), std::string::npos) << read_file(err);
-  EXPECT_EQ(read_file(out).find("published"), std::string::npos) << read_file(out);
+  const CliRun r =
+      mpm::test::run_captured(kMpm + " simulate-live --scenario plant-nominal --publish lcm --samples 5", "mpm_simplant_");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("plant-nominal needs --plant FILE"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("published"), std::string::npos) << r.out;
 }
 
 TEST(SimulatePlantCli, RunsOnEveryExamplePlantWithItsColumns) {

@@ -2,6 +2,8 @@
 // temporary file name, running a command quietly, reading a file whole.
 #pragma once
 
+#include <sys/wait.h>
+
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -26,6 +28,25 @@ inline std::string read_file(const std::string& path) {
   std::stringstream s;
   s << f.rdbuf();
   return s.str();
+}
+
+// tmp_path with the running test's name in it: ctest runs each test of a
+// file in a process of its own, in parallel, so names must not collide.
+inline std::string per_test_tmp_path(const std::string& prefix, const std::string& name) {
+  return tmp_path(prefix + ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_", name);
+}
+
+struct CliRun {
+  int exit_code = -1;  // -1: did not exit normally
+  std::string out, err;
+};
+
+// Runs `cmd`, capturing its exit code, standard output and standard error
+// (through files named from `prefix`, per test).
+inline CliRun run_captured(const std::string& cmd, const std::string& prefix) {
+  const std::string out = per_test_tmp_path(prefix, "stdout.txt"), err = per_test_tmp_path(prefix, "stderr.txt");
+  const int status = std::system((cmd + " >" + out + " 2>" + err).c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(out), read_file(err)};
 }
 
 }  // namespace mpm::test
