@@ -113,9 +113,19 @@ void extra_lag(const Context& cx, std::size_t j, std::size_t i, std::vector<Cand
 void integrator(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
   const DiscreteTf& g = *cx.channel(j, i);
   if (g.has_integrator()) return;
+  // Where the channel has a slow mode, the plant integrates in its place
+  // (its slowest pole moved to 1, the slope of its first moments kept);
+  // where it has none (a fast or static channel), the plant is the channel
+  // followed by an integrator (per sample, 1 / (1 - q^-1)).
   const double p = slowest_pole(g);
-  if (p < 0.5) return;
-  const DiscreteTf gi = move_pole(g, p, 1.0, 1.0);
+  const bool replaces_pole = p >= 0.5;
+  const auto integrating = [&](double gain) {
+    if (replaces_pole) return move_pole(g, p, 1.0, gain);
+    DiscreteTf s = series(g, DiscreteTf{{1.0}, {1.0, -1.0}, 0});
+    for (double& b : s.num) b *= gain;
+    return s;
+  };
+  const DiscreteTf gi = integrating(1.0);
   const Vec xi = simulate(gi, cx.problem.du.col(static_cast<Index>(i)));
   // An integrating plant holds still only at its own balance input, which
   // the self-regulating model's operating point need not be: under
@@ -130,11 +140,13 @@ void integrator(const Context& cx, std::size_t j, std::size_t i, std::vector<Can
   const double balance = k != 0.0 ? -f.fit.theta(1) / k : 0.0;
   Candidate c = make_candidate(cx, "integrator", {{j, i}}, {std::move(f)}, 2);
   c.finding.nominal = g;
-  c.finding.fitted = move_pole(g, p, 1.0, k);
-  c.finding.parameters["integrator_gain_per_sample"] = k * g.dc_gain() * (1.0 - p);
+  c.finding.fitted = integrating(k);
+  c.finding.parameters["integrator_gain_per_sample"] = k * g.dc_gain() * (replaces_pole ? 1.0 - p : 1.0);
   c.finding.parameters["balance_input_offset"] = balance;
-  c.finding.summary = arrow(cx, j, i) + " integrates: slowest pole " + fmt(p) + " -> 1, gain x " + fmt(k) +
-                      ", holding still at " + cx.problem.inputs[i] + " " + fmt(balance) + " from the model's operating point";
+  c.finding.summary = arrow(cx, j, i) + " integrates: " +
+                      (replaces_pole ? "slowest pole " + fmt(p) + " -> 1" : std::string("an integrator after the channel")) +
+                      ", gain x " + fmt(k) + ", holding still at " + cx.problem.inputs[i] + " " + fmt(balance) +
+                      " from the model's operating point";
   out.push_back(std::move(c));
 }
 

@@ -160,6 +160,17 @@ TEST(DiagnoseCli, MissingChannelIsNamedAndNoFindingRespondsWithinTheSample) {
   }
 }
 
+// The paper's 4x4 case 4.2.4: G32, a fast channel (tau 0.11 s at a 2 s
+// sample time, so no slow pole to move to 1), gains an integrator and the
+// loop diverges. The plant is the channel followed by an integrator.
+TEST(DiagnoseCli, IntegratorOnTheFourByFoursFastChannelIsNamed) {
+  const std::string r = diagnose_scenario("quad-tank-g32-integrator", 5, 3000,
+                                          std::string(MPM_SOURCE_DIR) + "/config/quad-tank-4x4.yaml");
+  EXPECT_EQ(physics_words(r), std::set<std::string>{"integrator"}) << r;
+  EXPECT_TRUE(names_channel(r, "y3", "\"u2\"")) << r;
+  EXPECT_NE(r.find("diverging"), std::string::npos) << r;  // and the report says the loop diverges
+}
+
 TEST(DiagnoseCli, ErrorsNameTheFileAndUseExitCodes) {
   EXPECT_EQ(WEXITSTATUS(run(kMpm + " diagnose --plant " + kWoodBerry)), 2);                       // --data missing
   EXPECT_EQ(WEXITSTATUS(run(kMpm + " diagnose --plant " + kWoodBerry + " --data /nonexistent.csv")), 1);
