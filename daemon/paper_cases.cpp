@@ -42,7 +42,7 @@ PaperCaseResult run_paper_case(const std::string& scenario, std::uint64_t seed, 
   if (!sc) throw std::invalid_argument("unknown scenario '" + scenario + "'");
   const sim::ResolvedPlant resolved = sim::default_plant(*sc);
   const PlantModel& plant = resolved.model;
-  sim::ClosedLoop loop(plant, sc->loop, seed);
+  sim::ClosedLoop loop(plant, sim::scenario_loop(*sc, plant), seed);
   const config::Recording rec = sim::simulate(loop, samples, scenario);
   if (!csv_out.empty()) config::write_recording(csv_out, rec);
 
