@@ -101,19 +101,76 @@ void deadband(const Context& cx, std::size_t i, const std::vector<std::size_t>& 
   out.push_back(std::move(c));
 }
 
-void nonlinear_gain(const Context& cx, std::size_t i, const std::vector<std::size_t>& js, std::vector<Candidate>& out) {
-  // Gain varying linearly with the input's level: effective input du + b du^2.
+// Mean of x over the fit part.
+double fit_mean(const Context& cx, const Vec& x) {
+  double sum = 0.0;
+  Index n = 0;
+  for (Index k = 0; k < x.size(); ++k)
+    if (cx.seg.fit[static_cast<std::size_t>(k)]) {
+      sum += x(k);
+      ++n;
+    }
+  return n ? sum / static_cast<double>(n) : 0.0;
+}
+
+// A static nonlinearity of input i around its working level, on the
+// channels js (one channel, or the input's whole column): the effective
+// input is du + a_j du + b_j e(v) + c_j o(v), with v = u - mean(u) on the fit
+// part, e(v) = v^2 and o(v) = v |v|, each centred and the odd term made
+// orthogonal to v on the fit part. Without the linear term, an input whose
+// mean sits away from the model's operating point makes v^2 a plain gain
+// change in disguise (two gains on one column then lost to one "nonlinear
+// gain"); without the odd term a map such as v (1 + a |v|) looked exactly a
+// gain. So the candidate is only offered when the nonlinear terms are
+// significant beyond the best linear gains on the same channels (nested
+// likelihood ratio, 2 degrees of freedom per channel, at the family-wise
+// level): a plain gain change is left to the gain hypotheses.
+void static_nonlinearity(const Context& cx, std::size_t i, const std::vector<std::size_t>& js,
+                         std::vector<Candidate>& out) {
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
-  const Vec u2 = u.cwiseProduct(u);
+  const Vec v = (u.array() - fit_mean(cx, u)).matrix();
+  Vec even = v.cwiseProduct(v);
+  even.array() -= fit_mean(cx, even);
+  Vec odd = v.cwiseProduct(v.cwiseAbs());
+  double vv = 0.0, ov = 0.0;
+  for (Index k = 0; k < v.size(); ++k)
+    if (cx.seg.fit[static_cast<std::size_t>(k)]) {
+      vv += v(k) * v(k);
+      ov += odd(k) * v(k);
+    }
+  if (vv <= 0.0) return;
+  odd -= (ov / vv) * v;
+  odd.array() -= fit_mean(cx, odd);
   std::vector<OutputFit> fits;
-  for (std::size_t j : js) fits.push_back(fit_output(cx, j, Vec(), {simulate(*cx.channel(j, i), u2)}));
-  const double b = fits[0].fit.theta(0);
-  Candidate c = make_candidate(cx, "nonlinear_gain", column_channels(js, i), std::move(fits), static_cast<int>(js.size()));
+  double nested = 0.0;
+  for (std::size_t j : js) {
+    const DiscreteTf& g = *cx.channel(j, i);
+    const Vec& lin = cx.gu[j * cx.n_in() + i];
+    const OutputFit linear = fit_output(cx, j, Vec(), {lin});
+    fits.push_back(fit_output(cx, j, Vec(), {lin, simulate(g, even), simulate(g, odd)}));
+    nested += std::log(linear.fit.fit_var / fits.back().fit.fit_var);
+  }
+  nested *= static_cast<double>(cx.seg.fit_samples());
+  const auto n_ch = static_cast<int>(js.size());
+  if (nested < chi_square_quantile_upper(cx.settings.alpha, 2.0 * n_ch)) return;
+  std::vector<Channel> cs = column_channels(js, i);
+  Candidate c = make_candidate(cx, "nonlinear_gain", cs, fits, 3 * n_ch);
   c.finding.nominal = *cx.channel(js[0], i);
   c.finding.fitted = *cx.channel(js[0], i);
-  c.finding.parameters["gain_slope_per_unit"] = 2.0 * b;
-  c.finding.summary = "gain of " + cx.problem.inputs[i] + " changes with its level (relative slope " + fmt(2.0 * b) +
-                      " per unit of " + cx.problem.inputs[i] + ")";
+  c.finding.parameters["nonlinear_lr"] = nested;
+  std::string terms;
+  for (std::size_t r = 0; r < js.size(); ++r) {
+    const LinearFit& f = c.fits[r].fit;
+    const std::string suffix = js.size() == 1 ? std::string() : "_" + cx.problem.outputs[js[r]];
+    c.finding.parameters["gain_factor" + suffix] = 1.0 + f.theta(0);
+    c.finding.parameters["even_coefficient" + suffix] = f.theta(1);
+    c.finding.parameters["odd_coefficient" + suffix] = f.theta(2);
+    terms += (r ? "; " : "") + cx.problem.outputs[js[r]] + ": gain x " + fmt(1.0 + f.theta(0)) + ", even " +
+             fmt(f.theta(1)) + ", odd " + fmt(f.theta(2));
+  }
+  c.finding.summary = "gain of " + cx.problem.inputs[i] + " changes with its level around " +
+                      fmt(cx.problem.u_abs(0, static_cast<Index>(i)) - u(0) + fit_mean(cx, u), 4) + " (" + terms +
+                      " per unit^2 of " + cx.problem.inputs[i] + ")";
   out.push_back(std::move(c));
 }
 
@@ -175,7 +232,9 @@ void column_hypotheses(const Context& cx, std::size_t i, std::vector<Candidate>&
   if (js.size() >= 2) actuator(cx, i, js, out);
   saturation(cx, i, js, out);
   deadband(cx, i, js, out);
-  nonlinear_gain(cx, i, js, out);
+  static_nonlinearity(cx, i, js, out);
+  if (js.size() >= 2)
+    for (std::size_t j : js) static_nonlinearity(cx, i, {j}, out);
 }
 
 void row_hypotheses(const Context& cx, std::size_t j, std::vector<Candidate>& out) {
@@ -276,8 +335,13 @@ void signal_hypotheses(const Context& cx, std::size_t j, std::size_t column, std
 
 void plant_hypotheses(const Context& cx, std::vector<Candidate>& out) {
   std::vector<std::size_t> js;
+  // Only outputs that several inputs drive: with one input, a gain set by
+  // the output's level is that channel's own static map, which the channel
+  // form tests against the best linear gain (static_nonlinearity); here it
+  // would take two plain gains on two single-input outputs for one
+  // nonlinearity.
   for (std::size_t j = 0; j < cx.n_out(); ++j)
-    if (!row_prediction(cx, j).channels.empty()) js.push_back(j);
+    if (row_prediction(cx, j).channels.size() >= 2) js.push_back(j);
   if (js.size() >= 2) level_gain(cx, js, out);
 }
 

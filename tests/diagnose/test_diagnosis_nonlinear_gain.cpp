@@ -1,0 +1,98 @@
+// The diagnosis library's static-nonlinearity form (`nonlinear_gain`): a
+// linear, a centred even and an odd term of the input around its working
+// level, offered only when the nonlinear terms are significant beyond the
+// best linear gains (nested test). Two plain gain changes on one input whose
+// level sits away from the model's operating point must stay two gains (the
+// old u^2 regressor took them for one column "nonlinear gain"), and an odd
+// map v (1 + a |v|), which an even-only form saw as a gain, must be named.
+#include <cmath>
+#include <cstddef>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/diagnosis.hpp"
+
+namespace {
+
+using mpm::DiscreteTf;
+namespace dg = mpm::diagnosis;
+
+const DiscreteTf kChannel{{0.1}, {1.0, -0.9}, 1};
+
+// One input u (steps held 10 samples, level `offset` + N(0, 0.7) from the
+// model's operating point), two outputs through kChannel each; the plant's
+// effective input into output j is map_j(du); white noise of sd 0.05.
+template <class Map1, class Map2>
+dg::Problem column_problem(unsigned seed, double offset, Map1 map1, Map2 map2, bool y2_flagged) {
+  const Eigen::Index n = 3000;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> level(offset, 0.7), noise(0.0, 0.05);
+  Eigen::VectorXd du(n), v1(n), v2(n);
+  double held = offset;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    if (k % 10 == 0) held = level(rng);
+    du(k) = held;
+    v1(k) = map1(held);
+    v2(k) = map2(held);
+  }
+  const auto sim = [&](const Eigen::VectorXd& x) {
+    Eigen::VectorXd y = Eigen::VectorXd::Zero(n);
+    for (Eigen::Index k = 2; k < n; ++k) y(k) = 0.9 * y(k - 1) + 0.1 * x(k - 1);
+    return y;
+  };
+  const Eigen::VectorXd g = sim(du), y1 = sim(v1), y2 = sim(v2);
+  dg::Problem p;
+  p.inputs = {"u"};
+  p.outputs = {"y1", "y2"};
+  p.du = Eigen::MatrixXd(n, 1);
+  p.du.col(0) = du;
+  p.u_abs = p.du;
+  p.residual = Eigen::MatrixXd(n, 2);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    p.residual(k, 0) = y1(k) - g(k) + noise(rng);
+    p.residual(k, 1) = y2(k) - g(k) + noise(rng);
+  }
+  p.nominal = {kChannel, kChannel};
+  p.noise = {DiscreteTf{{1.0}, {1.0}, 0}, DiscreteTf{{1.0}, {1.0}, 0}};
+  p.noise_variance = {0.05 * 0.05, 0.05 * 0.05};
+  p.monitor_flag = {true, y2_flagged};
+  p.monitor_located = {{0}, {0}};
+  return p;
+}
+
+TEST(DiagnosisNonlinearGain, TwoGainsOnOneInputAwayFromTheOperatingPointStayGains) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const dg::Result r = dg::diagnose(column_problem(
+        seed, 1.5, [](double v) { return 0.75 * v; }, [](double v) { return 1.3 * v; }, true));
+    std::string all;
+    for (const dg::Finding& f : r.findings) all += f.physics + ": " + f.summary + "; ";
+    ASSERT_EQ(r.findings.size(), 2u) << "seed " << seed << ": " << all;
+    for (const dg::Finding& f : r.findings) {
+      EXPECT_EQ(f.physics, "gain") << "seed " << seed << ": " << f.summary;
+      ASSERT_EQ(f.channels.size(), 1u) << "seed " << seed;
+      const double expected = f.channels[0].output == 0 ? 0.75 : 1.3;
+      EXPECT_NEAR(f.parameters.at("gain_factor"), expected, 0.05) << "seed " << seed << ": " << f.summary;
+    }
+  }
+}
+
+TEST(DiagnosisNonlinearGain, OddStaticMapOnOneChannelIsNamed) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const dg::Result r = dg::diagnose(column_problem(
+        seed, 0.0, [](double v) { return v * (1.0 + 0.5 * std::abs(v)); }, [](double v) { return v; }, false));
+    ASSERT_FALSE(r.findings.empty()) << "seed " << seed;
+    const dg::Finding& f = r.findings.front();
+    EXPECT_EQ(f.physics, "nonlinear_gain") << "seed " << seed << ": " << f.summary;
+    ASSERT_EQ(f.channels.size(), 1u) << "seed " << seed << ": " << f.summary;
+    EXPECT_EQ(f.channels[0].output, 0u) << "seed " << seed;
+    EXPECT_GT(f.parameters.at("odd_coefficient"), 0.0) << "seed " << seed << ": " << f.summary;
+    EXPECT_LT(f.fit.holdout_variance_after, f.fit.holdout_variance_before) << "seed " << seed;
+    // y2 is linear and unchanged: nothing there.
+    for (const dg::Finding& g : r.findings)
+      for (const dg::Channel& c : g.channels) EXPECT_EQ(c.output, 0u) << "seed " << seed << ": " << g.summary;
+  }
+}
+
+}  // namespace
