@@ -124,7 +124,8 @@ double fit_mean(const Context& cx, const Vec& x) {
 // gain. So the candidate is only offered when the nonlinear terms are
 // significant beyond the best linear gains on the same channels (nested
 // likelihood ratio, 2 degrees of freedom per channel, at the family-wise
-// level): a plain gain change is left to the gain hypotheses.
+// level, Bonferroni over the maps tried): a plain gain change is left to the
+// gain hypotheses.
 void static_nonlinearity(const Context& cx, std::size_t i, const std::vector<std::size_t>& js,
                          std::vector<Candidate>& out) {
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
@@ -152,7 +153,14 @@ void static_nonlinearity(const Context& cx, std::size_t i, const std::vector<std
   }
   nested *= static_cast<double>(cx.seg.fit_samples());
   const auto n_ch = static_cast<int>(js.size());
-  if (nested < chi_square_quantile_upper(cx.settings.alpha, 2.0 * n_ch)) return;
+  // Family-wise over every static map tried (each channel, and each column
+  // of two or more channels), as the candidates' own test is.
+  double tests = 0.0;
+  for (std::size_t c = 0; c < cx.n_in(); ++c) {
+    const auto m = static_cast<double>(column_outputs(cx, c).size());
+    tests += m + (m >= 2.0 ? 1.0 : 0.0);
+  }
+  if (nested < chi_square_quantile_upper(cx.settings.alpha / std::max(1.0, tests), 2.0 * n_ch)) return;
   std::vector<Channel> cs = column_channels(js, i);
   Candidate c = make_candidate(cx, "nonlinear_gain", cs, fits, 3 * n_ch);
   c.finding.nominal = *cx.channel(js[0], i);
