@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "child_process.hpp"
+#include "config/daemon_config.hpp"
 #include "daemon/mpmd/log.hpp"
 #include "daemon/mpmd/monitor_service.hpp"
 #include "daemon/mpmd/receiver.hpp"
@@ -311,6 +312,27 @@ TEST(ServiceLoopReload, ASighupStormIsLoggedAtALimitedRate) {
   thread.join();
   receiver.stop();
   EXPECT_EQ(logs.count("reload failed"), 1);
+}
+
+// --- configuration -------------------------------------------------------------
+
+TEST(WireSettings, ReadFromTheConfigurationWithLocatedErrors) {
+  const std::string base = "controller_id: wb\nplant: wood-berry.yaml\n";
+  const auto c = config::parse_daemon_config(base + "max_sequence_jump: 500\nstale_after: 12.5\n", "t.yaml",
+                                             MPM_SOURCE_DIR "/config");
+  EXPECT_EQ(c.max_sequence_jump, 500);
+  EXPECT_EQ(c.stale_after, 12.5);
+  const auto d = config::parse_daemon_config(base + "stale_after: auto\n", "t.yaml", MPM_SOURCE_DIR "/config");
+  EXPECT_EQ(d.stale_after, -1.0);
+  EXPECT_EQ(d.max_sequence_jump, SequenceTracker::kDefaultMaxJump);
+  for (const char* bad : {"max_sequence_jump: 0\n", "max_sequence_jump: 2.5\n", "stale_after: -3\n"}) {
+    try {
+      config::parse_daemon_config(base + bad, "t.yaml", MPM_SOURCE_DIR "/config");
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find("t.yaml:3:"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace
