@@ -65,6 +65,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // an input is counted and skipped, so that the search goes on: see
   // tests/fuzz/corpus/dds_sample/cyclone_0_10_2_xcdr2_bswap_overrun and
   // transport/README.md.
+  // The overrun reaches beyond any canary (heap corruption in ASan's own
+  // chunk headers after 0.5 M runs), so byte-swapped XCDR2 bodies are not fed
+  // to this Cyclone at all: the target checks the other three encodings, the
+  // canary stays for them (none overran in the runs reported in the README).
+  if (bswap && xcdr == 2) return 0;
   constexpr std::size_t kCanary = 1024;
   const auto body_size = static_cast<std::uint32_t>(size - 1);
   std::vector<std::uint64_t> aligned((body_size + kCanary + 7) / 8);
