@@ -73,7 +73,8 @@ MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& s
   const double auto_stale = std::max(60.0, 10.0 * plant.sample_time);
   stale_after_ = seconds(settings.stale_after < 0 ? auto_stale : settings.stale_after);
   for (Throttle* t : {&throttles_.foreign, &throttles_.gap, &throttles_.duplicate, &throttles_.out_of_order,
-                      &throttles_.restart, &throttles_.jump, &throttles_.malformed, &throttles_.nan, &throttles_.dropped,
+                      &throttles_.restart, &throttles_.jump, &throttles_.malformed, &throttles_.nan,
+                      &throttles_.dropped,
                       &throttles_.receive_errors}) {
     t->set_interval(interval);
   }

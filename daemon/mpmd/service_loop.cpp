@@ -118,7 +118,10 @@ void ServiceLoop::apply_reload() {
   std::string error;
   auto next = load_config(config_path_, error);
   if (!next) {
-    if (report) log::write(log::Level::kError, "reload failed, keeping the running configuration: %s%s", error.c_str(), suppressed);
+    if (report) {
+      log::write(log::Level::kError, "reload failed, keeping the running configuration: %s%s", error.c_str(),
+                 suppressed);
+    }
     notifier_.ready("reload failed; running the previous configuration");
     return;
   }
@@ -129,12 +132,17 @@ void ServiceLoop::apply_reload() {
       was.dds.domain != now.dds.domain || was.dds.config != now.dds.config ||
       was.dds.sample_topic != now.dds.sample_topic || was.dds.alarm_topic != now.dds.alarm_topic ||
       was.dds.status_topic != now.dds.status_topic || running_.config.queue_capacity != next->config.queue_capacity) {
-    if (report) log::write(log::Level::kWarning, "transport and queue settings take effect at the next restart%s", suppressed);
+    if (report) {
+      log::write(log::Level::kWarning, "transport and queue settings take effect at the next restart%s", suppressed);
+    }
   }
   if (next->monitor_fingerprint != running_.monitor_fingerprint) {
     auto service = make_service(*next, service_->alarm_sink(), error);
     if (!service) {
-      if (report) log::write(log::Level::kError, "reload failed, keeping the running configuration: %s%s", error.c_str(), suppressed);
+      if (report) {
+      log::write(log::Level::kError, "reload failed, keeping the running configuration: %s%s", error.c_str(),
+                 suppressed);
+    }
       notifier_.ready("reload failed; running the previous configuration");
       return;
     }
@@ -144,11 +152,15 @@ void ServiceLoop::apply_reload() {
     limits.n_u = static_cast<std::uint32_t>(next->plant.n_inputs());
     limits.n_y = static_cast<std::uint32_t>(next->plant.n_outputs());
     transport_.set_sample_limits(limits);
-    if (report) log::write(log::Level::kNotice, "reloaded %s: new monitor settings, statistics start again%s",
-               config_path_.c_str(), suppressed);
+    if (report) {
+      log::write(log::Level::kNotice, "reloaded %s: new monitor settings, statistics start again%s",
+                 config_path_.c_str(), suppressed);
+    }
   } else {
-    if (report) log::write(log::Level::kNotice, "reloaded %s: monitor unchanged, statistics kept%s", config_path_.c_str(),
-                           suppressed);
+    if (report) {
+      log::write(log::Level::kNotice, "reloaded %s: monitor unchanged, statistics kept%s", config_path_.c_str(),
+                 suppressed);
+    }
   }
   running_ = std::move(*next);
   notifier_.ready("reloaded");

@@ -119,7 +119,8 @@ TEST(LcmWire, DimensionsOfThePlantAreEnforced) {
 
 TEST(LcmWire, BrokenStringsAndTrailingBytesAreRefused) {
   msg::Sample out;
-  for (const std::int32_t n : {0, -1, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max()}) {
+  for (const std::int32_t n :
+       {0, -1, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max()}) {
     test::WireBytes w;
     w.fingerprint().i32(n);
     EXPECT_NE(decode(w.bytes, plant_limits(), out), WireError::kNone) << n;
@@ -228,7 +229,8 @@ TEST(LcmWire, TransportCountsHostileDatagramsAndKeepsReceiving) {
   valid.seq = 2;
   for (const auto* c : {&hostile, &off_by_one, &huge_sim, &valid}) {
     const auto bytes = c->encode();
-    ASSERT_EQ(lcm_publish(raw, settings.lcm.sample_channel.c_str(), bytes.data(), static_cast<unsigned>(bytes.size())), 0);
+    ASSERT_EQ(
+        lcm_publish(raw, settings.lcm.sample_channel.c_str(), bytes.data(), static_cast<unsigned>(bytes.size())), 0);
   }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   while (received.empty() && std::chrono::steady_clock::now() < deadline) {
