@@ -1,5 +1,6 @@
 #include "config/daemon_config.hpp"
 
+#include <cmath>
 #include <filesystem>
 
 #include "config/file_text.hpp"
@@ -131,6 +132,16 @@ void read_service(const YamlReader& r, const Field& root, DaemonConfig& c) {
     r.fail(r.child(root, "queue_capacity"), "expected a number of samples in 2..1048576");
   read(r, root, "log_interval", c.log_interval);
   if (c.log_interval < 0) r.fail(r.child(root, "log_interval"), "expected seconds >= 0");
+  if (const Field jump = r.child(root, "max_sequence_jump"); jump.present()) {
+    const double n = r.number(jump);
+    if (!(n >= 1 && n <= 1e15 && n == std::floor(n))) r.fail(jump, "expected a number of samples in 1..1e15");
+    c.max_sequence_jump = static_cast<std::int64_t>(n);
+  }
+  const Field stale = r.child(root, "stale_after");
+  if (stale.present() && !(stale.node.IsScalar() && stale.node.Scalar() == "auto")) {
+    read(r, root, "stale_after", c.stale_after);
+    if (!(c.stale_after >= 0)) r.fail(stale, "expected \"auto\" or seconds >= 0 (0 = never)");
+  }
 }
 
 }  // namespace
@@ -147,7 +158,7 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
   const Field root = r.root(document);
   try {
     r.check_keys(root, {"controller_id", "plant", "monitor", "transport", "status_period", "queue_capacity",
-                        "log_interval"});
+                        "log_interval", "max_sequence_jump", "stale_after"});
     DaemonConfig c;
     c.source = source_name;
     c.controller_id = r.name(r.child(root, "controller_id"));

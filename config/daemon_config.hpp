@@ -19,8 +19,11 @@
 //   status_period: 1.0              # seconds
 //   queue_capacity: 4096            # samples between receiver and monitor
 //   log_interval: 60                # seconds between repeats of one kind of log line
+//   max_sequence_jump: 1000000      # larger sequence jumps resynchronise (wire)
+//   stale_after: auto               # seconds without a usable sample: not ready
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "core/granger_monitor.hpp"
@@ -40,6 +43,8 @@ struct DaemonConfig {
   double status_period = 1.0;  // seconds between status messages
   int queue_capacity = 4096;   // samples buffered between receiver and monitor
   double log_interval = 60.0;  // seconds between repeats of one kind of log line
+  std::int64_t max_sequence_jump = 1000000;  // largest plausible sequence gap or step back
+  double stale_after = -1.0;   // seconds without a usable sample -> not ready; -1 = auto, 0 = never
 };
 
 // `base_dir` resolves relative paths (plant, DDS config); "" = as given.

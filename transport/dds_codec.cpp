@@ -1,6 +1,7 @@
 #include "transport/dds_codec.hpp"
 
 #include <algorithm>
+#include <cstring>
 
 namespace mpm::transport::dds_codec {
 
@@ -114,6 +115,42 @@ void to_wire(const msg::Status& in, mpm_dds_Status& out, Scratch& scratch) {
     scratch.loops[i] = {view(l.output), l.residual_variance, l.sigma1, l.sigma_full, l.alarm, l.diverging};
   }
   out.loops = view_of<dds_sequence_mpm_dds_LoopStatus>(scratch.loops);
+}
+
+namespace {
+
+// A string of at most `max` bytes (strnlen never reads past max + 1 bytes).
+bool string_ok(const char* s, std::uint32_t max) noexcept {
+  return s == nullptr || ::strnlen(s, std::size_t{max} + 1) <= max;
+}
+
+bool dimension_ok(std::uint32_t n, std::uint32_t expected, std::uint32_t cap) noexcept {
+  return expected != 0 ? n == expected : n <= cap;
+}
+
+}  // namespace
+
+WireError check(const mpm_dds_Sample& in, const SampleLimits& limits) noexcept {
+  if (!string_ok(in.controller_id, limits.max_string)) return WireError::kStringTooLong;
+  if (!dimension_ok(in.u._length, limits.n_u, limits.max_channels)) return WireError::kWrongInputs;
+  if (!dimension_ok(in.y._length, limits.n_y, limits.max_channels)) return WireError::kWrongOutputs;
+  if (in.sim_y._length != 0 && in.sim_y._length != in.y._length) return WireError::kWrongSimOutputs;
+  if (in.extra._length > limits.max_extra) return WireError::kTooManyExtras;
+  for (std::uint32_t i = 0; i < in.extra._length; ++i) {
+    if (!string_ok(in.extra._buffer[i].name, limits.max_string)) return WireError::kStringTooLong;
+  }
+  // A length with no buffer would be a broken deserialiser; refuse, not crash.
+  if ((in.u._length && !in.u._buffer) || (in.y._length && !in.y._buffer) ||
+      (in.sim_y._length && !in.sim_y._buffer) || (in.extra._length && !in.extra._buffer)) {
+    return WireError::kBadLength;
+  }
+  return WireError::kNone;
+}
+
+WireError from_wire(const mpm_dds_Sample& in, const SampleLimits& limits, msg::Sample& out) {
+  const WireError error = check(in, limits);
+  if (error == WireError::kNone) from_wire(in, out);
+  return error;
 }
 
 void from_wire(const mpm_dds_Sample& in, msg::Sample& out) {

@@ -252,6 +252,17 @@ class DdsTransport final : public Transport {
     return w > 0 ? w : 0;
   }
 
+  // Samples are checked against the limits before they are copied; alarms and
+  // status come from Cyclone's checked deserialiser into messages of our own.
+  bool convert(const mpm_dds_Sample& wire, msg::Sample& plain) {
+    return dds_codec::from_wire(wire, sample_limits(), plain) == WireError::kNone;
+  }
+  template <typename Wire, typename Plain>
+  bool convert(const Wire& wire, Plain& plain) {
+    dds_codec::from_wire(wire, plain);
+    return true;
+  }
+
   // Takes a batch on loan, converts each valid sample and hands it on.
   template <typename Wire, typename Plain, typename Handler>
   int take(dds_entity_t reader, Plain& plain, const Handler& handler) {
@@ -265,7 +276,10 @@ class DdsTransport final : public Transport {
     int handled = 0;
     for (dds_return_t i = 0; i < n; ++i) {
       if (!infos[static_cast<std::size_t>(i)].valid_data) continue;  // dispose / unregister notices
-      dds_codec::from_wire(*static_cast<const Wire*>(samples[static_cast<std::size_t>(i)]), plain);
+      if (!convert(*static_cast<const Wire*>(samples[static_cast<std::size_t>(i)]), plain)) {
+        ++receive_errors_;
+        continue;
+      }
       if (handler) handler(plain);
       ++handled;
     }

@@ -19,6 +19,7 @@
 #include <lcm/lcm.h>
 
 #include "transport/lcm_codec.hpp"
+#include "transport/lcm_wire.hpp"
 
 namespace mpm::transport {
 
@@ -28,6 +29,8 @@ namespace {
 // ours; a deeper one absorbs bursts while the receiver thread is descheduled.
 constexpr int kLcmQueueCapacity = 1000;
 constexpr int kMaxBatch = 256;
+// Channels (and loops) a status may list: a 256 x 256 plant.
+constexpr std::uint32_t kMaxStatusItems = 65536;
 
 class LcmTransport final : public Transport {
  public:
@@ -123,15 +126,16 @@ class LcmTransport final : public Transport {
     return lcm_publish(lcm_, channel.c_str(), tx_buffer_.data(), static_cast<unsigned>(size)) == 0;
   }
 
-  // Decodes into `wire` then `plain`; a message that fails either step is
-  // counted and dropped (bad bytes must never stop the receiver).
+  // Alarms and status (mpm listen): our walk checks every length against the
+  // bytes first (lcm_wire.hpp), then the generated decoder, which is safe on
+  // checked bytes; a message that fails is counted and dropped.
   template <typename Wire, typename Plain, typename Handler>
-  void receive(const lcm_recv_buf_t* rbuf, Wire& wire, Plain& plain, const Handler& handler) {
+  void receive(const lcm_recv_buf_t* rbuf, WireError checked, Wire& wire, Plain& plain, const Handler& handler) {
     bool ok = false;
     try {
-      ok = wire.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) >= 0 &&
+      ok = checked == WireError::kNone && wire.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) >= 0 &&
            lcm_codec::from_wire(wire, plain);
-    } catch (const std::exception&) {  // a hostile length can make a vector throw
+    } catch (const std::exception&) {
       ok = false;
     }
     if (!ok) {
@@ -141,9 +145,34 @@ class LcmTransport final : public Transport {
     if (handler) handler(plain);
   }
 
-  void receive_sample(const lcm_recv_buf_t* rbuf) { receive(rbuf, rx_sample_, sample_, on_sample_); }
-  void receive_alarm(const lcm_recv_buf_t* rbuf) { receive(rbuf, rx_alarm_, alarm_, on_alarm_); }
-  void receive_status(const lcm_recv_buf_t* rbuf) { receive(rbuf, rx_status_, status_, on_status_); }
+  // Samples never reach the generated decoder: ours checks every length
+  // against the bytes and the plant's dimensions before it writes.
+  void receive_sample(const lcm_recv_buf_t* rbuf) {
+    WireError error = WireError::kNone;
+    try {
+      error = decode_lcm_sample(rbuf->data, rbuf->data_size, sample_limits(), sample_);
+    } catch (const std::exception&) {  // bad_alloc while first sizing the message
+      error = WireError::kTruncated;
+    }
+    if (error != WireError::kNone) {
+      ++receive_errors_;
+      return;
+    }
+    if (on_sample_) on_sample_(sample_);
+  }
+  void receive_alarm(const lcm_recv_buf_t* rbuf) {
+    const auto checked = check_lcm_alarm(rbuf->data, rbuf->data_size, sample_limits().max_string);
+    receive(rbuf, checked, rx_alarm_, alarm_, on_alarm_);
+  }
+  void receive_status(const lcm_recv_buf_t* rbuf) {
+    const SampleLimits limits = sample_limits();
+    const auto checked = check_lcm_status(rbuf->data, rbuf->data_size, limits.max_string, kMaxStatusItems);
+    // Cleared: LCM 1.3 does not resize a zero-length array, so an empty list
+    // would keep the previous message's items.
+    rx_status_.channels.clear();
+    rx_status_.loops.clear();
+    receive(rbuf, checked, rx_status_, status_, on_status_);
+  }
 
   LcmSettings settings_;
   lcm_t* lcm_;
@@ -152,7 +181,6 @@ class LcmTransport final : public Transport {
   SampleHandler on_sample_;
   AlarmHandler on_alarm_;
   StatusHandler on_status_;
-  mpm_lcm::sample_t rx_sample_;
   mpm_lcm::alarm_t rx_alarm_;
   mpm_lcm::status_t rx_status_;
   msg::Sample sample_;

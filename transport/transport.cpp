@@ -6,14 +6,17 @@
 namespace mpm::transport {
 
 std::unique_ptr<Transport> create(const Settings& settings, std::string& error) {
+  std::unique_ptr<Transport> transport;
   switch (settings.kind) {
     case Kind::kLcm:
-      return make_lcm_transport(settings.lcm, error);
+      transport = make_lcm_transport(settings.lcm, error);
+      break;
     case Kind::kDds:
-      return make_dds_transport(settings.dds, error);
+      transport = make_dds_transport(settings.dds, error);
+      break;
   }
-  error = "unknown transport";
-  return nullptr;
+  if (transport) transport->set_sample_limits(settings.sample_limits);
+  return transport;
 }
 
 }  // namespace mpm::transport

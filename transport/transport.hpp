@@ -7,6 +7,7 @@
 // allow it, and the fake locks).
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -77,6 +78,32 @@ class Transport {
 
   // "lcm udpm://..." or "dds domain 0", for logs.
   virtual std::string describe() const = 0;
+
+  // What a received sample may contain (transport_settings.hpp): a sample
+  // beyond these is counted in receive_errors() and never handed on. May be
+  // called from any thread (a reload with a new plant); a sample being
+  // decoded meanwhile is judged by the old or the new limits.
+  void set_sample_limits(const SampleLimits& limits) noexcept {
+    n_u_.store(limits.n_u, std::memory_order_relaxed);
+    n_y_.store(limits.n_y, std::memory_order_relaxed);
+    max_channels_.store(limits.max_channels, std::memory_order_relaxed);
+    max_extra_.store(limits.max_extra, std::memory_order_relaxed);
+    max_string_.store(limits.max_string, std::memory_order_relaxed);
+  }
+  SampleLimits sample_limits() const noexcept {
+    SampleLimits l;
+    l.n_u = n_u_.load(std::memory_order_relaxed);
+    l.n_y = n_y_.load(std::memory_order_relaxed);
+    l.max_channels = max_channels_.load(std::memory_order_relaxed);
+    l.max_extra = max_extra_.load(std::memory_order_relaxed);
+    l.max_string = max_string_.load(std::memory_order_relaxed);
+    return l;
+  }
+
+ private:
+  std::atomic<std::uint32_t> n_u_{SampleLimits{}.n_u}, n_y_{SampleLimits{}.n_y},
+      max_channels_{SampleLimits{}.max_channels}, max_extra_{SampleLimits{}.max_extra},
+      max_string_{SampleLimits{}.max_string};
 };
 
 // Creates the transport the settings name. Returns nullptr and sets `error`

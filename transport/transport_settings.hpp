@@ -2,6 +2,7 @@
 // defaults of the README, so config files only say what differs.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 namespace mpm::transport {
@@ -27,8 +28,21 @@ struct DdsSettings {
   int sample_history = 64;  // KEEP_LAST depth of sample writer and reader
 };
 
+// What a received sample may contain. Every length on the wire is checked
+// against these (and against the bytes that remain) before anything is
+// allocated, so a hostile or broken publisher cannot make the receiver grow:
+// the memory a sample takes is bounded by the plant's dimensions.
+struct SampleLimits {
+  std::uint32_t n_u = 0;             // inputs the plant has; 0 = any up to max_channels
+  std::uint32_t n_y = 0;             // outputs (sim_y: 0 or n_y); 0 = any up to max_channels
+  std::uint32_t max_channels = 1024; // bound of u and y when the plant is not known (mpm listen)
+  std::uint32_t max_extra = 256;     // named extra signals
+  std::uint32_t max_string = 256;    // bytes of controller_id and of each extra name
+};
+
 struct Settings {
   Kind kind = Kind::kLcm;
+  SampleLimits sample_limits;  // set by mpmd from its plant
   LcmSettings lcm;
   DdsSettings dds;
 };

@@ -112,7 +112,12 @@ int main(int argc, char** argv) {
   }
 
   // 3. Transport, the bounded queue and the receiver thread.
-  transport = transport::create(loaded->config.transport, error);
+  // Every received sample is checked against the plant's dimensions before
+  // the transport copies it (transport/lcm_wire.hpp).
+  transport::Settings transport_settings = loaded->config.transport;
+  transport_settings.sample_limits.n_u = static_cast<std::uint32_t>(loaded->plant.n_inputs());
+  transport_settings.sample_limits.n_y = static_cast<std::uint32_t>(loaded->plant.n_outputs());
+  transport = transport::create(transport_settings, error);
   if (!transport) {
     log::write(log::Level::kError, "%s", error.c_str());
     return 1;

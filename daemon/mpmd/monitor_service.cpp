@@ -1,5 +1,6 @@
 #include "daemon/mpmd/monitor_service.hpp"
 
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -59,6 +60,7 @@ MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& s
       monitor_(plant.n_inputs(), plant.n_outputs(), settings.monitor, noise_ar(plant, settings.monitor.ar_order),
                reference_variances(plant),
                settings.plain_lags ? std::vector<std::optional<DiscreteTf>>{} : channel_models(plant)),
+      tracker_(settings.max_sequence_jump),
       residual_(plant.n_outputs(), 0.0),
       nan_u_(plant.n_inputs(), kNaN),
       nan_y_(plant.n_outputs(), kNaN),
@@ -68,8 +70,11 @@ MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& s
   settling_ = settle_;
   if (plant.operating_point) residuals_.emplace(plant, plant.operating_point->inputs);
   const auto interval = seconds(settings.log_interval);
+  const double auto_stale = std::max(60.0, 10.0 * plant.sample_time);
+  stale_after_ = seconds(settings.stale_after < 0 ? auto_stale : settings.stale_after);
   for (Throttle* t : {&throttles_.foreign, &throttles_.gap, &throttles_.duplicate, &throttles_.out_of_order,
-                      &throttles_.restart, &throttles_.malformed, &throttles_.nan, &throttles_.dropped,
+                      &throttles_.restart, &throttles_.jump, &throttles_.malformed, &throttles_.nan,
+                      &throttles_.dropped,
                       &throttles_.receive_errors}) {
     t->set_interval(interval);
   }
@@ -85,8 +90,17 @@ void MonitorService::on_sample(const msg::Sample& s, Clock::time_point now) {
     return;
   }
   ++counters_.seen;
+  // Sizes first: a malformed sample's numbers are not trusted, so it never
+  // moves the sequence or the session (the hole it leaves is filled when the
+  // next good sample arrives).
+  if (!sized_right(s)) {
+    report_malformed(s, now);
+    ++malformed_pending_;
+    return;
+  }
+  const std::int64_t previous_seq = tracker_.last();
   const SequenceTracker::Result r = tracker_.observe(s.session_id, s.seq);
-  report_sequence(r, s, now);
+  report_sequence(r, s, previous_seq, now);
   switch (r.verdict) {
     case SequenceTracker::Verdict::kDuplicate:
     case SequenceTracker::Verdict::kOutOfOrder:
@@ -95,17 +109,16 @@ void MonitorService::on_sample(const msg::Sample& s, Clock::time_point now) {
       skip_missing(r.missing);
       break;
     case SequenceTracker::Verdict::kRestart:
+    case SequenceTracker::Verdict::kJump:
       skip_missing(kResettleGap + 1);  // unknown gap: break the lags, settle again
       break;
     default:
       break;
   }
-  if (!sized_right(s)) {
-    report_malformed(s, now);
-    skip_missing(1);
-    return;
-  }
-  if (!all_finite(s.u) || !all_finite(s.y) || !all_finite(s.sim_y)) {
+  malformed_pending_ = 0;
+  const bool finite = all_finite(s.u) && all_finite(s.y) && all_finite(s.sim_y);
+  if (finite) last_usable_ = now;
+  if (!finite) {
     ++counters_.nan_samples;
     if (throttles_.nan.event(now)) {
       log::write(log::Level::kWarning,
@@ -220,18 +233,35 @@ void MonitorService::publish_alarm(std::size_t output, std::size_t input, const 
 }
 
 void MonitorService::report_sequence(const SequenceTracker::Result& r, const msg::Sample& s,
-                                     Clock::time_point now) {
+                                     std::int64_t previous_seq, Clock::time_point now) {
   using V = SequenceTracker::Verdict;
   const char* id = s.controller_id.c_str();
   switch (r.verdict) {
-    case V::kGap:
+    case V::kGap: {
+      // Samples that arrived malformed are counted there, not as missing.
+      const auto missing = static_cast<std::uint64_t>(r.missing);
+      if (missing <= malformed_pending_) break;
       ++counters_.gaps;
-      counters_.missing += static_cast<std::uint64_t>(r.missing);
+      counters_.missing += missing - malformed_pending_;
       if (throttles_.gap.event(now)) {
         log::write(log::Level::kWarning,
                    "controller '%s': %" PRId64 " samples missing before sample %" PRId64
                    " (gaps so far: %" PRIu64 ")%s",
-                   id, r.missing, s.seq, counters_.gaps, Suppressed(throttles_.gap).text);
+                   id, static_cast<std::int64_t>(missing - malformed_pending_), s.seq, counters_.gaps,
+                   Suppressed(throttles_.gap).text);
+      }
+      break;
+    }
+    case V::kJump:
+      ++counters_.jumps;
+      ++counters_.restarts;
+      if (throttles_.jump.event(now)) {
+        log::write(log::Level::kWarning,
+                   "controller '%s': sequence jumped from %" PRId64 " to %" PRId64
+                   " (more than max_sequence_jump %" PRId64 "): resynchronised on it, statistics kept "
+                   "(jumps so far: %" PRIu64 ")%s",
+                   id, previous_seq, s.seq, settings_.max_sequence_jump, counters_.jumps,
+                   Suppressed(throttles_.jump).text);
       }
       break;
     case V::kDuplicate:
@@ -246,7 +276,7 @@ void MonitorService::report_sequence(const SequenceTracker::Result& r, const msg
       if (throttles_.out_of_order.event(now)) {
         log::write(log::Level::kWarning,
                    "controller '%s': sample %" PRId64 " arrived after sample %" PRId64 ": ignored%s", id, s.seq,
-                   tracker_.last(), Suppressed(throttles_.out_of_order).text);
+                   previous_seq, Suppressed(throttles_.out_of_order).text);
       }
       break;
     case V::kRestart:
@@ -292,12 +322,35 @@ void MonitorService::add_receive_errors(std::uint64_t count, Clock::time_point n
   }
 }
 
+void MonitorService::check_health(Clock::time_point now) {
+  if (!watch_start_) watch_start_ = now;
+  if (stale_after_.count() <= 0) return;
+  const Clock::time_point since = last_usable_ ? *last_usable_ : *watch_start_;
+  const bool stale = now - since > stale_after_;
+  if (stale == stale_) return;
+  stale_ = stale;
+  const char* id = settings_.controller_id.c_str();
+  if (!stale) {
+    log::write(log::Level::kNotice, "controller '%s': usable samples again: status ready when warmed up", id);
+    return;
+  }
+  const char* why = counters_.seen == 0 ? "no sample of this controller has arrived"
+                    : last_usable_     ? "samples stopped, or none since was usable"
+                                       : "samples arrive but none was usable";
+  log::write(log::Level::kWarning,
+             "controller '%s': no usable sample for more than %.0f s (stale_after): status not ready; %s "
+             "(seen %" PRIu64 ", malformed %" PRIu64 ", NaN %" PRIu64 ", duplicates %" PRIu64
+             ", out of order %" PRIu64 ")",
+             id, stale_after_.count(), why, counters_.seen, counters_.malformed, counters_.nan_samples,
+             counters_.duplicates, counters_.out_of_order);
+}
+
 void MonitorService::fill_status(msg::Status& out, std::int64_t utime, std::int64_t uptime_ms) const {
   const MonitorCounters& mc = monitor_.counters();
   out.controller_id = settings_.controller_id;
   out.utime = utime;
   out.uptime_ms = uptime_ms;
-  out.ready = monitor_.ready();
+  out.ready = monitor_.ready() && !stale_;
   out.effective_samples = monitor_.effective_samples();
   out.raise_threshold = monitor_.raise_threshold();
   out.clear_threshold = monitor_.clear_threshold();

@@ -5,10 +5,11 @@
 // data-quality counters. Unit tests drive it directly or through the fake
 // transport; mpmd wires it to LCM or DDS.
 //
-// Per sample (on_sample): controller filter -> sequence check (duplicates and
-// out-of-order samples dropped, gaps filled with missing samples so the
-// model's time stays aligned) -> size check (a wrong-sized sample counts as
-// malformed and as a missing sample) -> residual (y - sim_y when the sample
+// Per sample (on_sample): controller filter -> size check (a wrong-sized
+// sample counts as malformed and never touches the sequence or session state)
+// -> sequence check (duplicates and out-of-order samples dropped, gaps filled
+// with missing samples so the model's time stays aligned, implausible jumps
+// resynchronised) -> residual (y - sim_y when the sample
 // carries the controller's prediction, else y - G_M (u - u0)) -> monitor
 // update -> alarm edges. Every anomaly is counted for the status and logged
 // through a Throttle (first at once, then at most once per log interval).
@@ -42,6 +43,12 @@ struct ServiceSettings {
   // gap) while its start-up transient decays; -1 = the plant's settling time.
   int settle_samples = -1;
   double log_interval = 60.0;  // seconds between repeats of one kind of log line
+  // Largest sequence gap (or step back) taken as plausible; beyond it the
+  // tracking resynchronises on the new number (sequence_tracker.hpp).
+  std::int64_t max_sequence_jump = SequenceTracker::kDefaultMaxJump;
+  // Seconds without a usable sample after which the status says not ready;
+  // -1 = automatic (the longer of 60 s and 10 sample times), 0 = never.
+  double stale_after = -1.0;
 };
 
 struct ServiceCounters {
@@ -51,6 +58,7 @@ struct ServiceCounters {
   std::uint64_t duplicates = 0;
   std::uint64_t out_of_order = 0;
   std::uint64_t restarts = 0;
+  std::uint64_t jumps = 0;         // implausible sequence jumps, resynchronised (also in restarts)
   std::uint64_t malformed = 0;     // wrong sizes, plus bytes the transport could not decode
   std::uint64_t nan_samples = 0;
   std::uint64_t dropped = 0;       // lost before the service (receive queue full)
@@ -79,6 +87,12 @@ class MonitorService {
   // operators do not keep seeing alarms nobody will clear.
   void retire(const std::string& reason);
 
+  // Whether a usable sample came within `stale_after` of `now`; logs when
+  // that changes, saying why. The status is not ready while stale. Call
+  // before fill_status (the service loop does, every turn).
+  void check_health(Clock::time_point now);
+  bool stale() const noexcept { return stale_; }
+
   // Current statistics and counters. Reuses `out`'s storage.
   void fill_status(msg::Status& out, std::int64_t utime, std::int64_t uptime_ms) const;
 
@@ -96,7 +110,8 @@ class MonitorService {
   void check_alarms(const msg::Sample& s);
   void publish_alarm(std::size_t output, std::size_t input, const msg::Sample& s);
   void fill_alarm_header(std::size_t output, std::size_t input, std::int64_t utime, std::int64_t seq);
-  void report_sequence(const SequenceTracker::Result& r, const msg::Sample& s, Clock::time_point now);
+  void report_sequence(const SequenceTracker::Result& r, const msg::Sample& s, std::int64_t previous_seq,
+                       Clock::time_point now);
   void report_malformed(const msg::Sample& s, Clock::time_point now);
 
   PlantModel plant_;
@@ -106,6 +121,11 @@ class MonitorService {
   std::optional<ResidualGenerator> residuals_;  // made at the first complete input sample
   SequenceTracker tracker_;
   ServiceCounters counters_;
+  std::uint64_t malformed_pending_ = 0;  // malformed since the last accepted sample: not gaps
+  std::chrono::duration<double> stale_after_{0.0};  // 0 = never stale
+  std::optional<Clock::time_point> last_usable_;    // last sample that reached the model, finite
+  std::optional<Clock::time_point> watch_start_;    // first check_health: the clock before any sample
+  bool stale_ = false;
   int settle_ = 0;       // samples to skip after a (re)start of the model
   int settling_ = 0;     // of those, still to skip
   std::vector<double> residual_;
@@ -114,7 +134,7 @@ class MonitorService {
   msg::Alarm alarm_;
 
   struct Throttles {
-    Throttle foreign, gap, duplicate, out_of_order, restart, malformed, nan, dropped, receive_errors;
+    Throttle foreign, gap, duplicate, out_of_order, restart, jump, malformed, nan, dropped, receive_errors;
   } throttles_;
 };
 

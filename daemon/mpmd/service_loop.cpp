@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cinttypes>
+#include <cstdio>
 
 #include "daemon/mpmd/log.hpp"
 
@@ -53,6 +54,7 @@ int ServiceLoop::run(const std::atomic<bool>& stop, std::atomic<bool>& reload) {
     drain(Clock::now());
     const auto now = Clock::now();
     account_losses(now);
+    service_->check_health(now);
     if (now >= next_status_) publish_status(now);
     feed_watchdog(now);
     if (queue_.size() > 0) continue;  // more than a batch waiting
@@ -101,12 +103,25 @@ void ServiceLoop::feed_watchdog(Clock::time_point now) {
   next_watchdog_ = now + *wd;
 }
 
+// A SIGHUP storm must not flood the journal: the lines of a reload are
+// rate-limited like every other kind of log line (the first at once, then
+// at most one per log_interval, saying how many reloads were not reported).
 void ServiceLoop::apply_reload() {
   notifier_.reloading();
+  reload_throttle_.set_interval(std::chrono::duration<double>(running_.config.log_interval));
+  const bool report = reload_throttle_.event(Clock::now());
+  char suppressed[64] = "";
+  if (report && reload_throttle_.suppressed() > 0) {
+    std::snprintf(suppressed, sizeof suppressed, " (%" PRIu64 " more reloads since the last report)",
+                  reload_throttle_.suppressed());
+  }
   std::string error;
   auto next = load_config(config_path_, error);
   if (!next) {
-    log::write(log::Level::kError, "reload failed, keeping the running configuration: %s", error.c_str());
+    if (report) {
+      log::write(log::Level::kError, "reload failed, keeping the running configuration: %s%s", error.c_str(),
+                 suppressed);
+    }
     notifier_.ready("reload failed; running the previous configuration");
     return;
   }
@@ -117,21 +132,35 @@ void ServiceLoop::apply_reload() {
       was.dds.domain != now.dds.domain || was.dds.config != now.dds.config ||
       was.dds.sample_topic != now.dds.sample_topic || was.dds.alarm_topic != now.dds.alarm_topic ||
       was.dds.status_topic != now.dds.status_topic || running_.config.queue_capacity != next->config.queue_capacity) {
-    log::write(log::Level::kWarning, "transport and queue settings take effect at the next restart");
+    if (report) {
+      log::write(log::Level::kWarning, "transport and queue settings take effect at the next restart%s", suppressed);
+    }
   }
   if (next->monitor_fingerprint != running_.monitor_fingerprint) {
     auto service = make_service(*next, service_->alarm_sink(), error);
     if (!service) {
-      log::write(log::Level::kError, "reload failed, keeping the running configuration: %s", error.c_str());
+      if (report) {
+      log::write(log::Level::kError, "reload failed, keeping the running configuration: %s%s", error.c_str(),
+                 suppressed);
+    }
       notifier_.ready("reload failed; running the previous configuration");
       return;
     }
     service_->retire("reloaded with new settings");
     service_ = std::move(service);
-    log::write(log::Level::kNotice, "reloaded %s: new monitor settings, statistics start again",
-               config_path_.c_str());
+    transport::SampleLimits limits = transport_.sample_limits();
+    limits.n_u = static_cast<std::uint32_t>(next->plant.n_inputs());
+    limits.n_y = static_cast<std::uint32_t>(next->plant.n_outputs());
+    transport_.set_sample_limits(limits);
+    if (report) {
+      log::write(log::Level::kNotice, "reloaded %s: new monitor settings, statistics start again%s",
+                 config_path_.c_str(), suppressed);
+    }
   } else {
-    log::write(log::Level::kNotice, "reloaded %s: monitor unchanged, statistics kept", config_path_.c_str());
+    if (report) {
+      log::write(log::Level::kNotice, "reloaded %s: monitor unchanged, statistics kept%s", config_path_.c_str(),
+                 suppressed);
+    }
   }
   running_ = std::move(*next);
   notifier_.ready("reloaded");

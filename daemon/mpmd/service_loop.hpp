@@ -16,6 +16,7 @@
 #include "daemon/mpmd/receiver.hpp"
 #include "daemon/mpmd/sample_queue.hpp"
 #include "daemon/mpmd/setup.hpp"
+#include "daemon/mpmd/throttle.hpp"
 #include "transport/transport.hpp"
 
 namespace mpm {
@@ -56,6 +57,7 @@ class ServiceLoop {
   std::uint64_t receive_errors_seen_ = 0;
   std::uint64_t status_failures_ = 0;
   msg::Status status_;
+  Throttle reload_throttle_;
 };
 
 }  // namespace mpm

@@ -26,7 +26,7 @@ std::string fingerprint(const config::DaemonConfig& c) {
     << m.ar_order << ' ' << m.input_order << ' ' << m.forgetting << ' ' << m.false_alarm << ' ' << m.clear_ratio
     << ' ' << m.raise_after << ' ' << m.clear_after << ' ' << m.warmup << ' ' << m.gamma_lambda << ' '
     << m.input_pole << ' ' << c.input_pole_auto << ' ' << c.plain_lags << ' ' << c.settle_samples << ' '
-    << c.log_interval << '\n'
+    << c.log_interval << ' ' << c.max_sequence_jump << ' ' << c.stale_after << '\n'
     << c.plant_path << '\n'
     << read_text(c.plant_path);
   return f.str();
@@ -58,6 +58,8 @@ std::unique_ptr<MonitorService> make_service(const LoadedConfig& loaded, Monitor
   settings.plain_lags = loaded.config.plain_lags;
   settings.settle_samples = loaded.config.settle_samples;
   settings.log_interval = loaded.config.log_interval;
+  settings.max_sequence_jump = loaded.config.max_sequence_jump;
+  settings.stale_after = loaded.config.stale_after;
   try {
     return std::make_unique<MonitorService>(loaded.plant, settings, std::move(on_alarm));
   } catch (const std::exception& e) {
