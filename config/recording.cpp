@@ -53,7 +53,14 @@ std::size_t count_fields(std::string_view line) {
   return static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
 }
 
-std::vector<std::string> parse_header(std::string_view line, const std::string& source) {
+std::vector<std::string> parse_header(std::string_view line, const std::string& source,
+                                      const Limits& limits) {
+  // Counted before anything is stored: a header of a million columns is an
+  // error here, not a million names and a rows x columns buffer.
+  if (const std::size_t n = count_fields(line); n > limits.max_csv_columns)
+    throw ConfigError(where(source, 1) + "header: expected 1.." +
+                      std::to_string(limits.max_csv_columns) + " columns, got " +
+                      std::to_string(n) + " (the limit is Limits::max_csv_columns)");
   std::vector<std::string> names;
   std::map<std::string_view, std::size_t> column_of;
   std::size_t start = 0;
@@ -125,7 +132,8 @@ std::optional<std::size_t> Recording::find(const std::string& name) const {
   return static_cast<std::size_t>(it - names.begin());
 }
 
-Recording parse_recording(const std::string& csv_text, const std::string& source_name) {
+Recording parse_recording(const std::string& csv_text, const std::string& source_name,
+                          const Limits& limits) {
   std::string_view text = csv_text;
   if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
   LineCursor lines(text);
@@ -133,10 +141,13 @@ Recording parse_recording(const std::string& csv_text, const std::string& source
     throw ConfigError(source_name + ":1: empty file, expected a header line with column names");
   Recording rec;
   rec.source = source_name;
-  rec.names = parse_header(lines.next(), source_name);
+  rec.names = parse_header(lines.next(), source_name, limits);
   const std::size_t cols = rec.names.size();
   std::vector<double> values;
-  values.reserve(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n') + 1) * cols);
+  // Every value takes at least one byte of the text (its comma or line
+  // break), so the text's size bounds the buffer whatever the line count.
+  const auto lines_left = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n') + 1);
+  values.reserve(std::min(lines_left * cols, text.size() + cols));
   while (!lines.only_blank_left()) {
     const std::string_view line = lines.next();
     parse_row(line, lines.number(), rec.names, source_name, values);
@@ -147,8 +158,8 @@ Recording parse_recording(const std::string& csv_text, const std::string& source
   return rec;
 }
 
-Recording load_recording(const std::string& path) {
-  return parse_recording(detail::read_file(path), path);
+Recording load_recording(const std::string& path, const Limits& limits) {
+  return parse_recording(detail::read_file(path, limits.max_csv_bytes), path, limits);
 }
 
 void write_recording(const std::string& path, const Recording& rec) {
