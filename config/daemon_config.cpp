@@ -5,6 +5,7 @@
 
 #include "config/file_text.hpp"
 #include "config/plant_loader.hpp"
+#include "config/strict_modes.hpp"
 #include "config/yaml_reader.hpp"
 
 namespace mpm::config {
@@ -176,7 +177,10 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
 
 DaemonConfig load_daemon_config(const std::string& path) {
   const std::string base_dir = std::filesystem::path(path).parent_path().string();
-  return parse_daemon_config(detail::read_file(path), path, base_dir);
+  check_strict_modes(path, "config");
+  DaemonConfig c = parse_daemon_config(detail::read_file(path, Limits{}.max_yaml_bytes), path, base_dir);
+  check_strict_modes(c.plant_path, "plant");
+  return c;
 }
 
 }  // namespace mpm::config

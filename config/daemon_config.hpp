@@ -50,6 +50,8 @@ struct DaemonConfig {
 // `base_dir` resolves relative paths (plant, DDS config); "" = as given.
 DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string& source_name,
                                  const std::string& base_dir);
+// Also refuses a config or plant file that group or others may write, or that
+// another non-root user owns (strict_modes.hpp).
 DaemonConfig load_daemon_config(const std::string& path);
 
 }  // namespace mpm::config

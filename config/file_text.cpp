@@ -5,6 +5,8 @@
 #include <cstring>
 #include <memory>
 
+#include <sys/stat.h>
+
 #include "config/plant_loader.hpp"
 
 namespace mpm::config::detail {
@@ -21,16 +23,27 @@ using File = std::unique_ptr<std::FILE, FileCloser>;
 
 }  // namespace
 
-std::string read_file(const std::string& path) {
+std::string read_file(const std::string& path, std::uint64_t max_bytes) {
   File file(std::fopen(path.c_str(), "rb"));
   if (!file) fail(path, "open", errno);
+  struct stat info {};
+  if (::fstat(::fileno(file.get()), &info) != 0) fail(path, "inspect", errno);
+  if (!S_ISREG(info.st_mode))
+    throw ConfigError(path + ": not a regular file (a device, FIFO or directory is not read)");
+  const auto too_big = [&] {
+    return ConfigError(path + ": file is larger than the limit of " + std::to_string(max_bytes) +
+                       " bytes");
+  };
+  if (static_cast<std::uint64_t>(info.st_size) > max_bytes) throw too_big();
   std::string text;
+  text.reserve(static_cast<std::size_t>(info.st_size));
   char buffer[1 << 16];
-  // Grow by fread chunks rather than trusting a size from fseek/ftell, which
-  // fails for pipes and /dev/stdin-like paths.
+  // The size from fstat is a hint: the file may grow while it is read, so the
+  // read itself stops one byte past the limit.
   for (;;) {
     const std::size_t got = std::fread(buffer, 1, sizeof buffer, file.get());
     text.append(buffer, got);
+    if (text.size() > max_bytes) throw too_big();
     if (got < sizeof buffer) break;
   }
   if (std::ferror(file.get())) fail(path, "read", errno);

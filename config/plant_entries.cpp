@@ -1,6 +1,7 @@
 #include "config/plant_entries.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
@@ -37,26 +38,42 @@ std::size_t index_of(const YamlReader& reader, const Field& field,
   return static_cast<std::size_t>(it - names.begin());
 }
 
-int read_delay(const YamlReader& reader, const Field& field) {
+int read_delay(const YamlReader& reader, const Field& field, const Limits& limits) {
   if (!field.present()) return 0;
   const int delay = reader.integer(field);
-  if (delay < 0) reader.fail(field, "expected a delay >= 0 samples, got " + std::to_string(delay));
-  if (delay > kMaxDelaySamples)
-    reader.fail(field, "delay of " + std::to_string(delay) + " samples is beyond the limit of " +
-                           std::to_string(kMaxDelaySamples));
+  if (delay < 0 || delay > limits.max_delay_samples)
+    reader.fail(field, "expected a delay in 0.." + std::to_string(limits.max_delay_samples) +
+                           " samples, got " + std::to_string(delay));
   return delay;
 }
 
+// A polynomial's coefficients, its length checked before they are read.
+std::vector<double> read_poly(const YamlReader& reader, const Field& field, const Limits& limits) {
+  if (field.present() && field.node.IsSequence() && field.node.size() > limits.max_poly_length)
+    reader.fail(field, "expected at most " + std::to_string(limits.max_poly_length) +
+                           " coefficients, got " + std::to_string(field.node.size()));
+  return reader.numbers(field);
+}
+
 // num, den (optional, default [1]) and delay (optional, default 0) of a
-// discrete entry, not yet normalised.
-DiscreteTf read_discrete(const YamlReader& reader, const Field& entry) {
+// discrete entry, normalised to den[0] = 1. Normalising can overflow (den[0]
+// = 1e-300): that error names the den key too.
+DiscreteTf read_discrete(const YamlReader& reader, const Field& entry, const Limits& limits) {
   DiscreteTf tf;
-  tf.num = reader.numbers(reader.child(entry, "num"));
+  const Field num = reader.child(entry, "num");
+  tf.num = read_poly(reader, num, limits);
   const Field den = reader.child(entry, "den");
-  tf.den = den.present() ? reader.numbers(den) : std::vector<double>{1.0};
+  tf.den = den.present() ? read_poly(reader, den, limits) : std::vector<double>{1.0};
   if (tf.den.front() == 0.0)
     reader.fail(reader.element(den, 0), "den[0] must be nonzero (den is normalised to den[0] = 1)");
-  tf.delay = read_delay(reader, reader.child(entry, "delay"));
+  tf.delay = read_delay(reader, reader.child(entry, "delay"), limits);
+  tf.normalise();  // den[0] != 0 and every coefficient finite: checked above
+  const auto finite = [](const std::vector<double>& v) {
+    return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+  };
+  if (!finite(tf.num) || !finite(tf.den))
+    reader.fail(den.present() ? den : num,
+                "cannot normalise to den[0] = 1: a coefficient overflows when divided by den[0]");
   return tf;
 }
 
@@ -68,13 +85,14 @@ std::vector<double> strip_leading_zeros(std::vector<double> p) {
   return p;
 }
 
-ContinuousTf read_continuous(const YamlReader& reader, const Field& field, double ts) {
+ContinuousTf read_continuous(const YamlReader& reader, const Field& field, double ts,
+                             const Limits& limits) {
   reader.check_keys(field, {"num", "den", "dead_time"});
   const Field num = reader.child(field, "num");
   const Field den = reader.child(field, "den");
   ContinuousTf g;
-  g.num = strip_leading_zeros(reader.numbers(num));
-  g.den = strip_leading_zeros(reader.numbers(den));
+  g.num = strip_leading_zeros(read_poly(reader, num, limits));
+  g.den = strip_leading_zeros(read_poly(reader, den, limits));
   if (all_zero(g.den)) reader.fail(den, "the denominator must not be zero");
   if (!all_zero(g.num) && g.num.size() > g.den.size())
     reader.fail(num, "improper transfer function: numerator degree " +
@@ -84,31 +102,11 @@ ContinuousTf read_continuous(const YamlReader& reader, const Field& field, doubl
   g.dead_time = dead.present() ? reader.number(dead) : 0.0;
   if (g.dead_time < 0.0)
     reader.fail(dead, "expected a dead time >= 0 seconds, got " + format_number(g.dead_time));
-  if (g.dead_time / ts > kMaxDelaySamples)
-    reader.fail(dead, "dead time of " + format_number(g.dead_time) + " s is more than " +
-                          std::to_string(kMaxDelaySamples) + " samples");
+  if (g.dead_time / ts > limits.max_delay_samples)
+    reader.fail(dead, "expected a dead time of 0.." + std::to_string(limits.max_delay_samples) +
+                          " samples (" + format_number(limits.max_delay_samples * ts) +
+                          " s), got " + format_number(g.dead_time) + " s");
   return g;
-}
-
-void fill_continuous(const YamlReader& reader, const Field& entry, double ts, ChannelModel& ch) {
-  for (const char* key : {"num", "den", "delay"}) {
-    const Field stray = reader.child(entry, key);
-    if (stray.present())
-      reader.fail(stray,
-                  "does not go with 'continuous': give num, den and dead_time inside "
-                  "continuous: {...}, or use the discrete form alone");
-  }
-  const Field field = reader.child(entry, "continuous");
-  ContinuousTf g = read_continuous(reader, field, ts);
-  ch.explicit_zero = all_zero(g.num);
-  if (!ch.explicit_zero) {
-    try {
-      ch.tf = discretize_zoh(g, ts);
-    } catch (const std::invalid_argument& e) {
-      reader.fail(field, std::string("cannot discretise: ") + e.what());
-    }
-  }
-  ch.continuous = std::move(g);
 }
 
 double largest_root(const std::vector<double>& ascending) {
@@ -118,6 +116,40 @@ double largest_root(const std::vector<double>& ascending) {
 
 // Roots this close to the unit circle count as on it (as has_integrator does).
 constexpr double kUnitCircleMargin = 1e-9;
+
+// The monitor's residual is y - G u with G run open loop (IMC): for a model
+// pole outside the unit circle it grows without bound and every later fit
+// sees infinities. Integrators (poles on the circle) are fine.
+void check_model_stable(const YamlReader& reader, const Field& den, const DiscreteTf& tf) {
+  const double pole = largest_root(tf.den);
+  if (pole > 1.0 + kUnitCircleMargin)
+    reader.fail(den, "expected a stable or integrating model (poles of magnitude <= 1), got a "
+                     "pole of magnitude " + format_number(pole) +
+                     ": the residual y - G u of an unstable model grows without bound");
+}
+
+void fill_continuous(const YamlReader& reader, const Field& entry, double ts, const Limits& limits,
+                     ChannelModel& ch) {
+  for (const char* key : {"num", "den", "delay"}) {
+    const Field stray = reader.child(entry, key);
+    if (stray.present())
+      reader.fail(stray,
+                  "does not go with 'continuous': give num, den and dead_time inside "
+                  "continuous: {...}, or use the discrete form alone");
+  }
+  const Field field = reader.child(entry, "continuous");
+  ContinuousTf g = read_continuous(reader, field, ts, limits);
+  ch.explicit_zero = all_zero(g.num);
+  if (!ch.explicit_zero) {
+    try {
+      ch.tf = discretize_zoh(g, ts);
+    } catch (const std::invalid_argument& e) {
+      reader.fail(field, std::string("cannot discretise: ") + e.what());
+    }
+    check_model_stable(reader, reader.child(field, "den"), ch.tf);
+  }
+  ch.continuous = std::move(g);
+}
 
 void check_noise_roots(const YamlReader& reader, const Field& entry, const DiscreteTf& tf) {
   const double pole = largest_root(tf.den);
@@ -134,36 +166,38 @@ void check_noise_roots(const YamlReader& reader, const Field& entry, const Discr
 
 }  // namespace
 
-ChannelModel read_channel(const YamlReader& reader, const Field& entry, const PlantModel& plant) {
+ChannelModel read_channel(const YamlReader& reader, const Field& entry, const PlantModel& plant,
+                          const Limits& limits) {
   reader.check_keys(entry, {"output", "input", "num", "den", "delay", "continuous"});
   ChannelModel ch;
   ch.output = index_of(reader, reader.child(entry, "output"), plant.outputs, "output");
   ch.input = index_of(reader, reader.child(entry, "input"), plant.inputs, "input");
   if (reader.child(entry, "continuous").present()) {
-    fill_continuous(reader, entry, plant.sample_time, ch);
+    fill_continuous(reader, entry, plant.sample_time, limits, ch);
     return ch;
   }
-  DiscreteTf tf = read_discrete(reader, entry);
+  DiscreteTf tf = read_discrete(reader, entry, limits);
   ch.explicit_zero = all_zero(tf.num);
   if (!ch.explicit_zero) {
-    tf.normalise();
+    const Field den = reader.child(entry, "den");
+    if (den.present()) check_model_stable(reader, den, tf);
     ch.tf = std::move(tf);
   }
   return ch;
 }
 
-NoiseEntry read_noise(const YamlReader& reader, const Field& entry, const PlantModel& plant) {
+NoiseEntry read_noise(const YamlReader& reader, const Field& entry, const PlantModel& plant,
+                      const Limits& limits) {
   reader.check_keys(entry, {"output", "num", "den", "delay", "variance"});
   NoiseEntry out;
   out.output = index_of(reader, reader.child(entry, "output"), plant.outputs, "output");
-  DiscreteTf tf = read_discrete(reader, entry);
+  DiscreteTf tf = read_discrete(reader, entry, limits);
   if (tf.delay != 0)
     reader.fail(reader.child(entry, "delay"),
                 "must be 0: a delayed disturbance model N has no causal inverse");
   if (tf.num.front() == 0.0)
     reader.fail(reader.element(reader.child(entry, "num"), 0),
                 "num[0] must be nonzero: N must be invertible (its inverse is den/num)");
-  tf.normalise();
   check_noise_roots(reader, entry, tf);
   out.model.tf = std::move(tf);
   const Field variance = reader.child(entry, "variance");

@@ -62,24 +62,38 @@ void check_names(const YamlReader& reader, const Field& root, const PlantModel& 
   }
 }
 
-void read_header(const YamlReader& reader, const Field& root, PlantModel& plant) {
+// The list of names under `key`, its length checked against `most` before
+// anything is read (a 2000 x 2000 plant is refused here, not after its model).
+std::vector<std::string> read_names(const YamlReader& reader, const Field& root, const char* key,
+                                    std::size_t most) {
+  const Field field = reader.child(root, key);
+  if (field.present() && field.node.IsSequence() && field.node.size() > most)
+    reader.fail(field, "expected 1.." + std::to_string(most) + " " + key + ", got " +
+                           std::to_string(field.node.size()) +
+                           " (the limit is Limits::max_" + key + ")");
+  return reader.names(field);
+}
+
+void read_header(const YamlReader& reader, const Field& root, const Limits& limits,
+                 PlantModel& plant) {
   plant.name = reader.name(reader.child(root, "plant"));
   const Field ts = reader.child(root, "sample_time");
   plant.sample_time = reader.number(ts);
   if (plant.sample_time <= 0.0)
     reader.fail(ts, "expected a sample time > 0 seconds, got " + ts.node.Scalar());
-  plant.inputs = reader.names(reader.child(root, "inputs"));
-  plant.outputs = reader.names(reader.child(root, "outputs"));
+  plant.inputs = read_names(reader, root, "inputs", limits.max_inputs);
+  plant.outputs = read_names(reader, root, "outputs", limits.max_outputs);
   check_names(reader, root, plant);
 }
 
-void read_model(const YamlReader& reader, const Field& root, PlantModel& plant) {
+void read_model(const YamlReader& reader, const Field& root, const Limits& limits,
+                PlantModel& plant) {
   const Field model = reader.child(root, "model");
   if (!model.present()) reader.fail(model, "missing (list the model's channels; [] for none)");
   std::map<std::pair<std::size_t, std::size_t>, std::string> seen;  // channel -> path
   for (std::size_t i = 0, n = reader.list_size(model, true); i < n; ++i) {
     const Field entry = reader.element(model, i);
-    ChannelModel ch = detail::read_channel(reader, entry, plant);
+    ChannelModel ch = detail::read_channel(reader, entry, plant, limits);
     const auto [it, fresh] = seen.emplace(std::pair{ch.output, ch.input}, entry.path);
     if (!fresh)
       reader.fail(entry, "duplicate channel " + plant.outputs[ch.output] + " <- " +
@@ -88,13 +102,14 @@ void read_model(const YamlReader& reader, const Field& root, PlantModel& plant) 
   }
 }
 
-void read_noise(const YamlReader& reader, const Field& root, PlantModel& plant) {
+void read_noise(const YamlReader& reader, const Field& root, const Limits& limits,
+                PlantModel& plant) {
   plant.noise.assign(plant.outputs.size(), std::nullopt);
   std::vector<std::string> given_by(plant.outputs.size());
   const Field noise = reader.child(root, "noise");
   for (std::size_t i = 0, n = reader.list_size(noise, true); i < n; ++i) {
     const Field entry = reader.element(noise, i);
-    detail::NoiseEntry e = detail::read_noise(reader, entry, plant);
+    detail::NoiseEntry e = detail::read_noise(reader, entry, plant, limits);
     if (plant.noise[e.output])
       reader.fail(entry, "duplicate noise model for output " + plant.outputs[e.output] +
                              " (already given by " + given_by[e.output] + ")");
@@ -126,16 +141,17 @@ void read_operating_point(const YamlReader& reader, const Field& root, PlantMode
 
 }  // namespace
 
-PlantModel parse_plant(const std::string& yaml_text, const std::string& source_name) {
+PlantModel parse_plant(const std::string& yaml_text, const std::string& source_name,
+                       const Limits& limits) {
   const YamlReader reader(source_name);
   const Field root = reader.root(load_yaml(yaml_text, source_name));
   try {
     reader.check_keys(
         root, {"plant", "sample_time", "inputs", "outputs", "model", "noise", "operating_point"});
     PlantModel plant;
-    read_header(reader, root, plant);
-    read_model(reader, root, plant);
-    read_noise(reader, root, plant);
+    read_header(reader, root, limits, plant);
+    read_model(reader, root, limits, plant);
+    read_noise(reader, root, limits, plant);
     read_operating_point(reader, root, plant);
     return plant;
   } catch (const YAML::Exception& e) {
@@ -145,8 +161,8 @@ PlantModel parse_plant(const std::string& yaml_text, const std::string& source_n
   }
 }
 
-PlantModel load_plant(const std::string& path) {
-  return parse_plant(detail::read_file(path), path);
+PlantModel load_plant(const std::string& path, const Limits& limits) {
+  return parse_plant(detail::read_file(path, limits.max_yaml_bytes), path, limits);
 }
 
 }  // namespace mpm::config

@@ -10,6 +10,7 @@
 
 #include <Eigen/Dense>
 
+#include "config/limits.hpp"
 #include "core/plant_model.hpp"
 
 namespace mpm::config {
@@ -24,8 +25,11 @@ struct ConfigError : std::runtime_error {
 // inputs/outputs (no duplicates), den[0] != 0, continuous channels proper and
 // discretised by ZOH, noise N invertible and stable with a stable inverse,
 // sample_time > 0, operating_point sizes match.
-PlantModel load_plant(const std::string& path);
-PlantModel parse_plant(const std::string& yaml_text, const std::string& source_name);
+// Dimensions, polynomial lengths, delays and the file size are capped by
+// `limits` (limits.hpp), each with a located error.
+PlantModel load_plant(const std::string& path, const Limits& limits = {});
+PlantModel parse_plant(const std::string& yaml_text, const std::string& source_name,
+                       const Limits& limits = {});
 
 // A CSV recording: header names and a samples x columns matrix (NaN = missing).
 struct Recording {
@@ -35,8 +39,10 @@ struct Recording {
   std::optional<std::size_t> find(const std::string& name) const;
   std::size_t samples() const { return static_cast<std::size_t>(data.rows()); }
 };
-Recording load_recording(const std::string& path);
-Recording parse_recording(const std::string& csv_text, const std::string& source_name);
+// The header's column count and the file size are capped by `limits`.
+Recording load_recording(const std::string& path, const Limits& limits = {});
+Recording parse_recording(const std::string& csv_text, const std::string& source_name,
+                          const Limits& limits = {});
 void write_recording(const std::string& path, const Recording& rec);
 
 // Column indices of a recording matched to a plant.

@@ -11,6 +11,7 @@
 #include <map>
 #include <string_view>
 
+#include "config/csv_rows.hpp"
 #include "config/file_text.hpp"
 #include "config/number_text.hpp"
 #include "config/plant_loader.hpp"
@@ -53,7 +54,33 @@ std::size_t count_fields(std::string_view line) {
   return static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
 }
 
-std::vector<std::string> parse_header(std::string_view line, const std::string& source) {
+}  // namespace
+
+namespace detail {
+namespace {
+double parse_field_value(std::string_view field, const std::string& source, std::size_t line,
+                   const std::string& column) {
+  field = trim(field);
+  if (field.empty() || detail::is_nan_word(field)) return std::numeric_limits<double>::quiet_NaN();
+  const auto value = detail::parse_double(field);
+  if (!value || !std::isfinite(*value))
+    throw ConfigError(where(source, line) + "column '" + column +
+                      "': expected a finite number (or an empty field or nan for a missing "
+                      "sample), got '" +
+                      std::string(field) + "'");
+  return *value;
+}
+
+}  // namespace
+
+std::vector<std::string> parse_csv_header(std::string_view line, const std::string& source,
+                                          const Limits& limits) {
+  // Counted before anything is stored: a header of a million columns is an
+  // error here, not a million names and a rows x columns buffer.
+  if (const std::size_t n = count_fields(line); n > limits.max_csv_columns)
+    throw ConfigError(where(source, 1) + "header: expected 1.." +
+                      std::to_string(limits.max_csv_columns) + " columns, got " +
+                      std::to_string(n) + " (the limit is Limits::max_csv_columns)");
   std::vector<std::string> names;
   std::map<std::string_view, std::size_t> column_of;
   std::size_t start = 0;
@@ -75,23 +102,9 @@ std::vector<std::string> parse_header(std::string_view line, const std::string& 
   return names;
 }
 
-double parse_field(std::string_view field, const std::string& source, std::size_t line,
-                   const std::string& column) {
-  field = trim(field);
-  if (field.empty() || detail::is_nan_word(field)) return std::numeric_limits<double>::quiet_NaN();
-  const auto value = detail::parse_double(field);
-  if (!value || !std::isfinite(*value))
-    throw ConfigError(where(source, line) + "column '" + column +
-                      "': expected a finite number (or an empty field or nan for a missing "
-                      "sample), got '" +
-                      std::string(field) + "'");
-  return *value;
-}
-
-// Appends one data line's values; throws on a wrong field count or a bad value.
-void parse_row(std::string_view line, std::size_t line_number,
-               const std::vector<std::string>& names, const std::string& source,
-               std::vector<double>& values) {
+void parse_csv_row(std::string_view line, std::size_t line_number,
+                   const std::vector<std::string>& names, const std::string& source,
+                   std::vector<double>& values) {
   std::size_t start = 0;
   for (std::size_t col = 0; col < names.size(); ++col) {
     const auto comma = line.find(',', start);
@@ -100,10 +113,18 @@ void parse_row(std::string_view line, std::size_t line_number,
       throw ConfigError(where(source, line_number) + "expected " + std::to_string(names.size()) +
                         " fields (as in the header), got " + std::to_string(count_fields(line)));
     values.push_back(
-        parse_field(line.substr(start, comma - start), source, line_number, names[col]));
+        parse_field_value(line.substr(start, comma - start), source, line_number, names[col]));
     start = comma + 1;
   }
 }
+
+bool is_blank_line(std::string_view line) {
+  return line.find_first_not_of(" \t\r") == std::string_view::npos;
+}
+
+}  // namespace detail
+
+namespace {
 
 void append_value(std::string& out, double x, const std::string& path, std::size_t row,
                   const std::string& column) {
@@ -125,7 +146,8 @@ std::optional<std::size_t> Recording::find(const std::string& name) const {
   return static_cast<std::size_t>(it - names.begin());
 }
 
-Recording parse_recording(const std::string& csv_text, const std::string& source_name) {
+Recording parse_recording(const std::string& csv_text, const std::string& source_name,
+                          const Limits& limits) {
   std::string_view text = csv_text;
   if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
   LineCursor lines(text);
@@ -133,13 +155,16 @@ Recording parse_recording(const std::string& csv_text, const std::string& source
     throw ConfigError(source_name + ":1: empty file, expected a header line with column names");
   Recording rec;
   rec.source = source_name;
-  rec.names = parse_header(lines.next(), source_name);
+  rec.names = detail::parse_csv_header(lines.next(), source_name, limits);
   const std::size_t cols = rec.names.size();
   std::vector<double> values;
-  values.reserve(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n') + 1) * cols);
+  // Every value takes at least one byte of the text (its comma or line
+  // break), so the text's size bounds the buffer whatever the line count.
+  const auto lines_left = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n') + 1);
+  values.reserve(std::min(lines_left * cols, text.size() + cols));
   while (!lines.only_blank_left()) {
     const std::string_view line = lines.next();
-    parse_row(line, lines.number(), rec.names, source_name, values);
+    detail::parse_csv_row(line, lines.number(), rec.names, source_name, values);
   }
   const auto rows = static_cast<Eigen::Index>(values.size() / cols);
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -147,8 +172,8 @@ Recording parse_recording(const std::string& csv_text, const std::string& source
   return rec;
 }
 
-Recording load_recording(const std::string& path) {
-  return parse_recording(detail::read_file(path), path);
+Recording load_recording(const std::string& path, const Limits& limits) {
+  return parse_recording(detail::read_file(path, limits.max_csv_bytes), path, limits);
 }
 
 void write_recording(const std::string& path, const Recording& rec) {

@@ -46,8 +46,11 @@ void dead_time(const Context& cx, std::size_t j, std::size_t i, std::vector<Cand
   int best = 0;
   double best_obj = std::numeric_limits<double>::infinity();
   // Shorter down to the model's own delay (never below the recording's
-  // fewest samples an input needs to act), or longer.
-  const int shortest = std::max(-g.delay, cx.min_input_delay - cx.response_delay(j, i));
+  // fewest samples an input needs to act), or longer; both ways within the
+  // search range, so a model delay of thousands of samples costs no more
+  // fits than a short one.
+  const int shortest = std::max({-g.delay, cx.min_input_delay - cx.response_delay(j, i),
+                                 -cx.settings.max_extra_delay});
   for (int s = shortest; s <= cx.settings.max_extra_delay; ++s) {
     if (s == 0) continue;
     const double o = objective(cx, {fit_output(cx, j, shifted(x, s) - x, {})});

@@ -40,11 +40,17 @@ inline double sum(Lanes v) noexcept {
 // The sums of four vectors at once, {sum(a), sum(b), sum(c), sum(d)}: four
 // shuffles and three additions instead of four separate reductions.
 static_assert(kLanes == 4, "sum4 transposes four vectors of four lanes");
+#if defined(__clang__)  // clang spells GCC's __builtin_shuffle with constant indices
+#define MPM_SHUFFLE(x, y, i, j, k, l) __builtin_shufflevector(x, y, i, j, k, l)
+#else
+#define MPM_SHUFFLE(x, y, i, j, k, l) __builtin_shuffle(x, y, LaneMask{i, j, k, l})
+#endif
 inline Lanes sum4(Lanes a, Lanes b, Lanes c, Lanes d) noexcept {
-  const Lanes ab = __builtin_shuffle(a, b, LaneMask{0, 4, 2, 6}) + __builtin_shuffle(a, b, LaneMask{1, 5, 3, 7});
-  const Lanes cd = __builtin_shuffle(c, d, LaneMask{0, 4, 2, 6}) + __builtin_shuffle(c, d, LaneMask{1, 5, 3, 7});
-  return __builtin_shuffle(ab, cd, LaneMask{0, 1, 4, 5}) + __builtin_shuffle(ab, cd, LaneMask{2, 3, 6, 7});
+  const Lanes ab = MPM_SHUFFLE(a, b, 0, 4, 2, 6) + MPM_SHUFFLE(a, b, 1, 5, 3, 7);
+  const Lanes cd = MPM_SHUFFLE(c, d, 0, 4, 2, 6) + MPM_SHUFFLE(c, d, 1, 5, 3, 7);
+  return MPM_SHUFFLE(ab, cd, 0, 1, 4, 5) + MPM_SHUFFLE(ab, cd, 2, 3, 6, 7);
 }
+#undef MPM_SHUFFLE
 constexpr LaneMask kLaneIndex = {0, 1, 2, 3};
 
 // Rotates the pivot row a, scaled by `scale` first, against row b so that

@@ -5,11 +5,11 @@
 // compares structured hypotheses fitted to the whitened residual.
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "config/output_file.hpp"
 #include "config/plant_loader.hpp"
 #include "core/diagnosis.hpp"
 #include "core/granger_monitor.hpp"
@@ -28,6 +28,8 @@ constexpr const char* kUsage =
     "  actuator / sensor lag, saturation, deadband, nonlinear gain, unmodelled recorded\n"
     "  signal, disturbance model) on 70 % of the record, checked on the other 30 %.\n"
     "  Writes the diagnosis JSON (formats.md section 3) to OUT.json, or to stdout.\n"
+    "  Exit status: 0 done, 1 error (also a failed write; OUT.json may not be an input),\n"
+    "  2 usage, 3 cannot decide (too few samples with every input and output finite).\n"
     "options:\n"
     "  --json OUT.json   where to write the report (default: standard output)\n"
     "  --quiet           no progress lines on standard error\n"
@@ -152,6 +154,7 @@ int run(int argc, char** argv) {
     g_quiet = args.flag("quiet");
     const std::string plant_path = args.required("plant");
     const std::string data_path = args.required("data");
+    if (const auto out = args.get("json")) config::refuse_input_as_output(*out, {plant_path, data_path});
     const PlantModel plant = config::load_plant(plant_path);
     const config::Recording rec = config::load_recording(data_path);
     const config::BoundRecording bound = config::bind(plant, rec);
@@ -162,6 +165,20 @@ int run(int argc, char** argv) {
     settings.forgetting = 1.0;
     const GrangerMonitor monitor = monitor_record(plant, series, settings, replay_threads(plant.n_outputs()));
     const RecordVerdict verdict = record_verdict(monitor);
+    // A header-only or all-NaN record leaves every statistic at its prior
+    // (F = 0, p = 1): that is no evidence of a match, so say so instead of
+    // printing "mismatch": false.
+    const std::uint64_t needed = 2 + static_cast<std::uint64_t>(settings.ar_order) +
+                                 plant.n_inputs() * static_cast<std::uint64_t>(settings.input_order);
+    if (monitor.counters().used < needed) {
+      std::fprintf(stderr,
+                   "mpm diagnose: cannot decide: %llu of %zu samples could be used (rows with "
+                   "every input and output finite, after the model settles); the tests need at "
+                   "least %llu\n",
+                   static_cast<unsigned long long>(monitor.counters().used), rec.samples(),
+                   static_cast<unsigned long long>(needed));
+      return 3;
+    }
 
     progress("fitting structured hypotheses");
     const diagnosis::Problem problem = diagnosis_problem(plant, rec, bound, series, verdict);
@@ -171,14 +188,10 @@ int run(int argc, char** argv) {
     if (verdict.diverging) result.notes.push_back("the monitor finds a diverging loop: its statistics are not trusted");
 
     const std::string json = report_json(plant, rec.samples(), monitor, verdict, result);
-    if (const auto out = args.get("json")) {
-      std::ofstream f(*out);
-      if (!f) throw std::runtime_error("cannot write " + *out);
-      f << json;
-      if (!f) throw std::runtime_error("error writing " + *out);
-    } else {
-      std::fputs(json.c_str(), stdout);
-    }
+    if (const auto out = args.get("json"))
+      config::write_output_file(*out, json);
+    else
+      config::write_stdout(json);
     return 0;
   } catch (const UsageError& e) {
     std::fprintf(stderr, "mpm diagnose: %s\n%s", e.what(), kUsage);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <string>
 
+#include "config/output_file.hpp"
 #include "daemon/args.hpp"
 #include "daemon/command.hpp"
 #include "daemon/paper_cases.hpp"
@@ -95,6 +96,7 @@ int run(int argc, char** argv) {
     if (n == 0) throw UsageError("no paper case named '" + only + "'");
     std::printf("\nsummary: mpm right on %d/%d cases; decussation right on %d/%d analysable cases\n", ours, n, theirs,
                 n - (only.empty() ? 1 : 0));
+    config::write_stdout("");  // flushes; a failed write of the report is an error
     return 0;
   } catch (const UsageError& e) {
     std::fprintf(stderr, "mpm paper: %s\n%s", e.what(), kUsage);

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "config/output_file.hpp"
 #include "config/plant_loader.hpp"
 #include "daemon/args.hpp"
 #include "daemon/command.hpp"
@@ -141,6 +142,7 @@ int run_simulate(int argc, char** argv) {
     const sim::Scenario& scenario = *sim::find_scenario(scenario_name);
     sim::ResolvedPlant plant = plant_path ? sim::ResolvedPlant{config::load_plant(*plant_path), *plant_path}
                                           : sim::default_plant(scenario);
+    config::refuse_input_as_output(out_path, {plant.source});
     std::vector<sim::EditSpec> edits;
     sim::LoopConfig loop_config = sim::scenario_loop(scenario, plant.model);
     try {
@@ -163,6 +165,7 @@ int run_simulate(int argc, char** argv) {
     std::printf("wrote %s: %zu samples of %s (plant %s, seed %llu); input limits active at %zu samples\n",
                 out_path.c_str(), samples, what.c_str(), plant.source.c_str(),
                 static_cast<unsigned long long>(seed), loop.controller().constrained_samples());
+    config::write_stdout("");  // flushes; a failed write of the line above is an error
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mpm simulate: %s\n", e.what());

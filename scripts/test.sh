@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite: installs what is missing, builds and runs every test
-# twice, as a Release build and as an ASan+UBSan build.
+# twice, as a Release build and as an ASan+UBSan build, then every fuzz target
+# for a bounded time (tests/fuzz; 20 s each under CI=true).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/deps.sh
@@ -18,5 +19,12 @@ cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMPM_SANITIZER=addre
 cmake --build build-asan -j"$jobs"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-asan --output-on-failure -j"$jobs" --timeout 900 -LE no-sanitizer || status=1
+
+echo "== Fuzz targets (clang, libFuzzer + ASan/UBSan), a bounded run of each on its corpus"
+# Only the libraries the fuzz targets link are built; scripts/fuzz.sh runs longer.
+CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMPM_FUZZ=ON \
+      -DMPM_BUILD_TESTS=OFF -DMPM_BUILD_BENCH=OFF >/dev/null
+cmake --build build-fuzz -j"$jobs" --target mpm_fuzzers
+ctest --test-dir build-fuzz --output-on-failure -j"$jobs" -L fuzz || status=1
 
 exit $status

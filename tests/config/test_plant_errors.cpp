@@ -74,7 +74,7 @@ std::vector<ErrorCase> error_cases() {
        "outputs", "expected a non-empty list of names"},
       {"NegativeDelay",
        h + "model:\n  - output: y1\n    input: u1\n    num: [1]\n    delay: -2   #!\n",
-       "model[0].delay", "delay >= 0"},
+       "model[0].delay", "delay in 0..1000 samples, got -2"},
       {"FractionalDelay",
        h + "model:\n  - output: y1\n    input: u1\n    num: [1]\n    delay: 1.5   #!\n",
        "model[0].delay", "expected an integer"},

@@ -1,5 +1,6 @@
 // `mpm diagnose` on simulated recordings with known truth: the report keeps
 // the contract of formats.md section 3 and names the planted mismatch.
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <set>
@@ -177,6 +178,71 @@ TEST(DiagnoseCli, ErrorsNameTheFileAndUseExitCodes) {
   const std::string err = tmp_path("err.txt");
   std::system((kMpm + " diagnose --plant " + kWoodBerry + " --data /nonexistent.csv 2>" + err).c_str());
   EXPECT_NE(read_file(err).find("/nonexistent.csv"), std::string::npos);
+}
+
+// Output safety (issue 12): the report never replaces an input, a failed
+// write is a failure, and a record with nothing usable is "cannot decide"
+// (exit 3), not "mismatch": false with p = 1.
+class DiagnoseOutput : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    csv_ = mpm::test::per_test_tmp_path("mpm_diag_out_", "run.csv");
+    ASSERT_EQ(run(kMpm + " simulate --scenario wood-berry-nominal --samples 600 --seed 3 --out " + csv_), 0);
+  }
+  mpm::test::CliRun diagnose(const std::string& data, const std::string& tail) const {
+    return mpm::test::run_captured(kMpm + " diagnose --quiet --plant " + kWoodBerry + " --data " + data + tail,
+                                   "mpm_diag_out_");
+  }
+  std::string csv_;
+};
+
+TEST_F(DiagnoseOutput, JsonEqualToDataIsRefusedAndTheRecordingKept) {
+  const std::string before = read_file(csv_);
+  const auto r = diagnose(csv_, " --json " + csv_);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("refusing to overwrite an input"), std::string::npos) << r.err;
+  EXPECT_EQ(read_file(csv_), before);
+  const auto p = diagnose(csv_, " --json " + kWoodBerry);
+  EXPECT_EQ(p.exit_code, 1) << "the plant file is an input too";
+}
+
+TEST_F(DiagnoseOutput, WriteErrorGivesNonZeroExit) {
+  const int to_full = std::system(
+      (kMpm + " diagnose --quiet --plant " + kWoodBerry + " --data " + csv_ + " >/dev/full 2>/dev/null").c_str());
+  EXPECT_EQ(WEXITSTATUS(to_full), 1);
+  EXPECT_EQ(diagnose(csv_, " --json /dev/full").exit_code, 1);
+}
+
+TEST_F(DiagnoseOutput, HeaderOnlyOrAllNanRecordCannotDecide) {
+  const std::string text = read_file(csv_);
+  const std::string header = text.substr(0, text.find('\n') + 1);
+  const std::string header_only = mpm::test::per_test_tmp_path("mpm_diag_out_", "header.csv");
+  std::ofstream(header_only) << header;
+  // Every value but the time column missing.
+  const std::string all_nan = mpm::test::per_test_tmp_path("mpm_diag_out_", "nan.csv");
+  {
+    std::ofstream f(all_nan);
+    f << header;
+    const auto columns = static_cast<std::size_t>(std::count(header.begin(), header.end(), ','));
+    for (int k = 0; k < 400; ++k) f << k << std::string(columns, ',') << "\n";
+  }
+  for (const std::string& data : {header_only, all_nan}) {
+    const auto r = diagnose(data, "");
+    EXPECT_EQ(r.exit_code, 3) << data << "\n" << r.out << r.err;
+    EXPECT_NE(r.err.find("cannot decide"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("\"mismatch\": false"), std::string::npos) << r.out;
+  }
+}
+
+TEST(SimulateOutput, OutEqualToPlantIsRefused) {
+  const std::string plant = mpm::test::per_test_tmp_path("mpm_sim_out_", "plant.yaml");
+  std::ofstream(plant) << read_file(kWoodBerry);
+  const std::string before = read_file(plant);
+  const auto r = mpm::test::run_captured(
+      kMpm + " simulate --scenario plant-nominal --plant " + plant + " --samples 50 --out " + plant, "mpm_sim_out_");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("refusing to overwrite an input"), std::string::npos) << r.err;
+  EXPECT_EQ(read_file(plant), before);
 }
 
 }  // namespace

@@ -1,0 +1,25 @@
+// Caps on what a loaded file may ask for. A plant or recording is untrusted
+// input: without a cap, one typo (a 2000 x 2000 plant, a dead time in seconds
+// where minutes were meant, a CSV header of a million columns) makes a loader
+// or a later setup step allocate gigabytes or run for minutes. Every cap is
+// checked while loading, and its error names the file, line:column, key and
+// the allowed range. The defaults cover every plant in the tree with a wide
+// margin; a caller with a bigger plant passes its own Limits.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace mpm::config {
+
+struct Limits {
+  std::size_t max_inputs = 100;            // plant inputs (manipulated variables)
+  std::size_t max_outputs = 100;           // plant outputs (controlled variables)
+  std::size_t max_poly_length = 200;       // coefficients in one num or den
+  int max_delay_samples = 1000;            // pure delay of one channel, in samples
+  std::uint64_t max_yaml_bytes = 64u << 20;  // a plant or daemon config file
+  std::size_t max_csv_columns = 10000;     // columns of a recording's header
+  std::uint64_t max_csv_bytes = std::uint64_t{16} << 30;  // a whole recording read at once
+};
+
+}  // namespace mpm::config
