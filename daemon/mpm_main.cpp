@@ -39,6 +39,10 @@ int main(int argc, char** argv) {
     usage(stdout);
     return 0;
   }
+  if (!std::strcmp(argv[1], "--version")) {
+    std::printf("mpm %s\n", MPM_VERSION);
+    return 0;
+  }
   for (const auto& c : mpm::commands()) {
     if (std::strcmp(argv[1], c.name) == 0) return c.run(argc - 1, argv + 1);
   }

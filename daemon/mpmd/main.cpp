@@ -64,6 +64,9 @@ int parse_options(int argc, char** argv, Options& options) {
     if (arg == "--help" || arg == "-h") {
       std::fputs(kUsage, stdout);
       return -1;
+    } else if (arg == "--version") {
+      std::printf("mpmd %s\n", MPM_VERSION);
+      return -1;
     } else if (arg == "--config" && i + 1 < argc) {
       options.config_path = argv[++i];
     } else if (arg.rfind("--config=", 0) == 0) {
