@@ -11,7 +11,7 @@ jsonschema.Draft7Validator.check_schema(schema)
 validator = jsonschema.Draft7Validator(schema)
 named = sys.argv[2:]
 found = []
-for path in glob.glob(os.path.join(tempfile.gettempdir(), "**", "mpm_*.json"), recursive=True):
+for path in glob.glob(os.path.join(tempfile.gettempdir(), "mpm_*.json")):
     try:
         doc = json.load(open(path))
     except (ValueError, OSError):
