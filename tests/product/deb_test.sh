@@ -14,7 +14,8 @@ for f in ./usr/bin/mpm ./usr/bin/mpmd ./usr/bin/mpm-lcm-spy \
          ./usr/lib/systemd/system/mpmd.service ./usr/lib/systemd/system/mpmd@.service \
          ./etc/mpm/mpmd.yaml ./etc/mpm/wood-berry.yaml ./etc/mpm/cyclonedds-loopback.xml \
          ./usr/share/doc/mpm/README.md ./usr/share/doc/mpm/formats.md ./usr/share/doc/mpm/diagnosis.schema.json \
-         ./usr/share/mpm/java/mpm-lcm-types.jar ./usr/share/mpm/examples/mpmd-wood-berry-lcm.yaml; do
+         ./usr/share/mpm/java/mpm-lcm-types.jar ./usr/share/mpm/examples/mpmd-wood-berry-lcm.yaml \
+         ./usr/share/man/man1/mpm.1 ./usr/share/man/man8/mpmd.8; do
   grep -qx "$f" "$work/contents.txt" || { echo "missing from the .deb: $f"; missing=1; }
 done
 # /etc files once, not under a doubled prefix (the old DESTDIR bug).
