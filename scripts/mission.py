@@ -61,6 +61,15 @@ for f in r["findings"]:
 if not r["findings"]:
     print("   no finding (the mission failed on this seed)")
 
+# Fit % per output from the HTML report's table (simulation and one step ahead).
+import re
+page = open(html).read()
+cells = {k: re.findall(r"<td class=%s>([^<]*)" % k, page) for k in ("fitb", "fita", "fit1b", "fit1a")}
+print("   fit % (NRMSE, as MATLAB compare) with the nominal -> the corrected model, per output:")
+for j, loop in enumerate(r["loops"]):
+    f = [float(cells[k][j]) if cells[k][j] != "null" else float("nan") for k in ("fitb", "fita", "fit1b", "fit1a")]
+    print("     %-4s simulation %6.1f -> %6.1f   one step ahead %5.1f -> %5.1f" % (loop["output"], *f))
+
 after = out + "/diagnosis-corrected.json"
 run("diagnose", "--quiet", "--plant", fixed, "--data", mismatched, "--json", after)
 r2 = json.load(open(after))
