@@ -236,6 +236,15 @@ void write_text_file(const std::string& path, const std::string& text, const std
   for (const std::string& q : protected_paths)
     if (fs::exists(path, ec) && fs::exists(q, ec) && fs::equivalent(path, q, ec))
       throw std::runtime_error("refusing to overwrite input file " + path + " (write the result elsewhere)");
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec)) {
+    // A device or a pipe (/dev/stdout, a FIFO): written in place; a rename
+    // would replace the device node with a file.
+    std::ofstream f(path, std::ios::binary);
+    f << text;
+    f.flush();
+    if (!f) throw std::runtime_error("error writing " + path);
+    return;
+  }
   const std::string tmp = path + ".tmp";
   {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
