@@ -155,8 +155,9 @@ void write_products(const Args& args, const std::string& plant_path, const std::
   const std::vector<std::string> inputs{plant_path, data_path};
   const CorrectedPlant corrected = apply_findings(plant, result);
   if (plant_out) {
-    write_text_file(*plant_out, plant_yaml(corrected, plant_path, data_path), inputs);
-    config::load_plant(*plant_out);  // what we wrote must read back
+    const std::string yaml = plant_yaml(corrected, plant_path, data_path);
+    config::parse_plant(yaml, *plant_out);  // what we write must read back
+    write_text_file(*plant_out, yaml, inputs);
     if (!g_quiet) std::fprintf(stderr, "mpm diagnose: corrected plant written to %s\n", plant_out->c_str());
   }
   if (html_out) {
