@@ -24,7 +24,7 @@ const std::vector<Command>& commands() { return registry(); }
 namespace {
 
 void usage(std::FILE* out) {
-  std::fprintf(out, "usage: mpm <command> [options]   (mpm <command> --help for its options)\n\ncommands:\n");
+  std::fprintf(out, "usage: mpm <command> [options]   (mpm <command> --help for its options; mpm --version)\n\ncommands:\n");
   for (const auto& c : mpm::commands()) std::fprintf(out, "  %-10s %s\n", c.name, c.summary);
 }
 

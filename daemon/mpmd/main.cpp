@@ -50,7 +50,8 @@ constexpr const char* kUsage =
     "usage: mpmd --config FILE\n"
     "  Watches one controller for model-plant mismatch (see README: mpmd).\n"
     "  --config FILE   service configuration (YAML)\n"
-    "  --check         load and validate the configuration, then exit\n";
+    "  --check         load and validate the configuration, then exit\n"
+    "  --version       print the version and exit\n";
 
 struct Options {
   std::string config_path;
