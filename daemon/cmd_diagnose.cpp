@@ -16,6 +16,8 @@
 #include "daemon/args.hpp"
 #include "daemon/command.hpp"
 #include "daemon/offline.hpp"
+#include "daemon/plant_writer.hpp"
+#include "daemon/report_html.hpp"
 
 namespace mpm {
 namespace {
@@ -32,6 +34,9 @@ constexpr const char* kUsage =
     "  2 usage, 3 cannot decide (too few samples with every input and output finite).\n"
     "options:\n"
     "  --json OUT.json   where to write the report (default: standard output)\n"
+    "  --write-plant P2.yaml  also write the plant file with the accepted corrections\n"
+    "                    applied, each change commented (never the input plant file)\n"
+    "  --html REPORT.html  also write a self-contained HTML report (plots, fit %)\n"
     "  --quiet           no progress lines on standard error\n"
     "  --verbose         also list every hypothesis tried, with its statistics\n"
     "  --help            this text\n";
@@ -142,11 +147,33 @@ std::string report_json(const PlantModel& plant, std::size_t samples, const Gran
   return o.str();
 }
 
+// --- What an engineer takes away: the corrected plant, the HTML report --------
+
+void write_products(const Args& args, const std::string& plant_path, const std::string& data_path,
+                    const PlantModel& plant, const diagnosis::Problem& problem, const GrangerMonitor& monitor,
+                    const RecordVerdict& verdict, const diagnosis::Result& result) {
+  const auto plant_out = args.get("write-plant"), html_out = args.get("html");
+  if (!plant_out && !html_out) return;
+  const std::vector<std::string> inputs{plant_path, data_path};
+  const CorrectedPlant corrected = apply_findings(plant, result);
+  if (plant_out) {
+    const std::string yaml = plant_yaml(corrected, plant_path, data_path);
+    config::parse_plant(yaml, *plant_out);  // what we write must read back
+    write_text_file(*plant_out, yaml, inputs);
+    if (!g_quiet) std::fprintf(stderr, "mpm diagnose: corrected plant written to %s\n", plant_out->c_str());
+  }
+  if (html_out) {
+    write_text_file(*html_out, report_html({plant, corrected, problem, monitor, verdict, result, plant_path, data_path}),
+                    inputs);
+    if (!g_quiet) std::fprintf(stderr, "mpm diagnose: HTML report written to %s\n", html_out->c_str());
+  }
+}
+
 // --- Problem set-up ----------------------------------------------------------
 
 int run(int argc, char** argv) {
   try {
-    const Args args(argc, argv, {"plant", "data", "json"}, {"help", "quiet", "verbose"});
+    const Args args(argc, argv, {"plant", "data", "json", "write-plant", "html"}, {"help", "quiet", "verbose"});
     if (args.flag("help")) {
       std::fputs(kUsage, stdout);
       return 0;
@@ -192,6 +219,7 @@ int run(int argc, char** argv) {
       config::write_output_file(*out, json);
     else
       config::write_stdout(json);
+    write_products(args, plant_path, data_path, plant, problem, monitor, verdict, result);
     return 0;
   } catch (const UsageError& e) {
     std::fprintf(stderr, "mpm diagnose: %s\n%s", e.what(), kUsage);

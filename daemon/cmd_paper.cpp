@@ -3,6 +3,7 @@
 // decussation baseline's verdict and the figures the paper reports.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include "config/output_file.hpp"
@@ -70,6 +71,7 @@ int run(int argc, char** argv) {
     const auto seed = static_cast<std::uint64_t>(args.integer("seed", 1));
     const std::string only = args.get("scenario").value_or("");
     const std::string out_dir = args.get("out").value_or("");
+    if (!out_dir.empty()) std::filesystem::create_directories(out_dir);  // throws, naming it, when it cannot
     MonitorSettings settings;  // whole record (lambda = 1)
     settings.input_order = args.integer("input-order", settings.input_order);
     settings.ar_order = args.integer("ar-order", settings.ar_order);

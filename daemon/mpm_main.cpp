@@ -24,7 +24,7 @@ const std::vector<Command>& commands() { return registry(); }
 namespace {
 
 void usage(std::FILE* out) {
-  std::fprintf(out, "usage: mpm <command> [options]   (mpm <command> --help for its options)\n\ncommands:\n");
+  std::fprintf(out, "usage: mpm <command> [options]   (mpm <command> --help for its options; mpm --version)\n\ncommands:\n");
   for (const auto& c : mpm::commands()) std::fprintf(out, "  %-10s %s\n", c.name, c.summary);
 }
 
@@ -37,6 +37,10 @@ int main(int argc, char** argv) {
   }
   if (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") || !std::strcmp(argv[1], "help")) {
     usage(stdout);
+    return 0;
+  }
+  if (!std::strcmp(argv[1], "--version")) {
+    std::printf("mpm %s\n", MPM_VERSION);
     return 0;
   }
   for (const auto& c : mpm::commands()) {

@@ -34,6 +34,7 @@ foreach(pair
   if(EXISTS "${_etc}/${_to}")
     message(STATUS "Kept (exists): ${_etc}/${_to}")
   else()
-    file(INSTALL "${MPM_SOURCE_DIR}/${_from}" DESTINATION "${_etc}")
+    # file(INSTALL) puts DESTDIR in front itself: name the final directory.
+    file(INSTALL "${MPM_SOURCE_DIR}/${_from}" DESTINATION "${MPM_CONFIG_DIR}")
   endif()
 endforeach()

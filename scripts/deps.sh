@@ -12,6 +12,8 @@ packages=(
   iproute2 openjdk-17-jdk-headless
   # lcm-spy screenshot test
   libjchart2d-java xvfb xdotool imagemagick
+  # the HTML report inlines dygraphs; its test renders it in headless Chromium
+  libjs-dygraphs chromium python3 python3-jsonschema
 )
 missing=()
 for p in "${packages[@]}"; do

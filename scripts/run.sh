@@ -1,12 +1,23 @@
 #!/usr/bin/env bash
 # The main job, end to end on a fresh Debian 12 machine: install what is
-# missing, build (Release), then reproduce the paper's Wood-Berry G21 x 1.2
-# case: simulate it under the MPC, run the online monitor over the recording
-# and print the located channel with F, p and gamma beside the paper's figures.
+# missing, build (Release), then
+#  1. the mission (scripts/mission.py): simulate a gain mismatch the MPC
+#     hides (control-error variance beside the matched plant's), diagnose it
+#     (located channel, physics word, fitted gain beside the true one,
+#     held-out improvement), write the corrected plant and the HTML report,
+#     and diagnose again with the corrected plant;
+#  2. the paper's table (`mpm paper`): every case study under the MPC, the
+#     located channels with F, p and gamma beside the paper's figures.
+# Everything written goes to out/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/deps.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$(nproc)"
-mkdir -p out
+mkdir -p out/mission
+echo
+echo "=== The mission: a concealed mismatch, located, named, fitted, written back ==="
+python3 scripts/mission.py build/daemon/mpm config/wood-berry.yaml out/mission
+echo
+echo "=== The paper's case studies (Chen, Xie & Su 2021) ==="
 build/daemon/mpm paper --out out

@@ -50,7 +50,8 @@ constexpr const char* kUsage =
     "usage: mpmd --config FILE\n"
     "  Watches one controller for model-plant mismatch (see README: mpmd).\n"
     "  --config FILE   service configuration (YAML)\n"
-    "  --check         load and validate the configuration, then exit\n";
+    "  --check         load and validate the configuration, then exit\n"
+    "  --version       print the version and exit\n";
 
 struct Options {
   std::string config_path;
@@ -63,6 +64,9 @@ int parse_options(int argc, char** argv, Options& options) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
       std::fputs(kUsage, stdout);
+      return -1;
+    } else if (arg == "--version") {
+      std::printf("mpmd %s\n", MPM_VERSION);
       return -1;
     } else if (arg == "--config" && i + 1 < argc) {
       options.config_path = argv[++i];

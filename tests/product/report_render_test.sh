@@ -1,0 +1,12 @@
+#!/bin/sh
+# The HTML report of a diagnosed gain mismatch, rendered in headless
+# Chromium: every plot drew, no console output (render_report.py).
+# usage: report_render_test.sh MPM SOURCE_DIR WORK_DIR
+set -eu
+mpm=$1; src=$2; work=$3
+mkdir -p "$work"
+"$mpm" simulate --scenario wood-berry-nominal --edit y2.u1.gain=1.5 --samples 3000 --seed 5 --out "$work/run.csv" >/dev/null
+"$mpm" diagnose --quiet --plant "$src/config/wood-berry.yaml" --data "$work/run.csv" --json "$work/report.json" \
+  --html "$work/report.html"
+grep -q '"physics": "gain"' "$work/report.json"
+python3 "$src/tests/product/render_report.py" "$work/report.html" "$work/report.png"
