@@ -41,7 +41,7 @@ void read_monitor(const YamlReader& r, const Field& root, DaemonConfig& c) {
   const Field m = r.child(root, "monitor");
   if (!m.present() || m.node.IsNull()) return;
   r.check_keys(m, {"ar_order", "input_order", "forgetting", "false_alarm", "false_alarms_per_year", "sample_time",
-                   "crossing_constant", "outlier_limit", "warmup", "gamma_lambda", "input_pole", "regressors",
+                   "crossing_constant", "detector_thresholds", "outlier_limit", "warmup", "gamma_lambda", "input_pole", "regressors",
                    "settle_samples"});
   MonitorSettings& s = c.monitor;
   read(r, m, "ar_order", s.ar_order);
@@ -52,6 +52,7 @@ void read_monitor(const YamlReader& r, const Field& root, DaemonConfig& c) {
   read(r, m, "sample_time", s.detector.sample_time);
   read(r, m, "crossing_constant", s.detector.crossing_constant);
   read(r, m, "outlier_limit", s.outlier_limit);
+  if (const Field t = r.child(m, "detector_thresholds"); t.present()) s.detector.thresholds = r.numbers(t);
   read(r, m, "warmup", s.warmup);
   read(r, m, "gamma_lambda", s.gamma_lambda);
   const Field pole = r.child(m, "input_pole");

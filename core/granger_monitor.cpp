@@ -29,6 +29,16 @@ constexpr double kFastMemory = 0.99;  // ~100-sample variance estimate
 // a ~200-sample memory (clipped at the limit, so an outlier cannot inflate
 // it); this many consecutive rejections are a level shift, accepted.
 constexpr std::uint64_t kOutlierLearn = 50;
+// Long detector windows need their own information matrix (d x d per
+// window and output): kept up to this many input regressors; beyond, only
+// the first (exactly self-normalised) window runs.
+constexpr std::size_t kLongWindowMaxDof = 100;
+// One long window's information refreshed every this many samples.
+constexpr std::uint64_t kRefreshEvery = 32;
+// A long window is tested once its information has had this many refreshes:
+// before, J_W is a few snapshots of S against a score summed over
+// everything in between (measured: raises at the first refreshes).
+constexpr std::uint32_t kMinRefreshes = 8;
 constexpr double kJumpMemory = 0.995;
 constexpr int kOutlierRunAccept = 5;
 // Mean absolute value of a standard normal: mean |change| / this = sigma.
@@ -149,9 +159,16 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   // however the inputs moved, so T is chi-square even across setpoint steps
   // (measured: shorter windows normalised by S raise on every step).
   DetectorSettings detector = settings.detector;
+  if (d > kLongWindowMaxDof) {
+    detector.windows = 1;
+    if (detector.thresholds.size() > 1) detector.thresholds.erase(detector.thresholds.begin() + 1, detector.thresholds.end());
+  }
   if (detector.first_window == 0.0)
     detector.first_window = settings.forgetting < 1.0 ? std::min(2.0 / (1.0 - settings.forgetting), 1e6) : 2000.0;
-  detector_ = SequentialDetector(n_outputs, d, detector, n_outputs);
+  // Long windows are looked at when their information is refreshed: one
+  // (output, window) every kRefreshEvery samples, round robin.
+  const double long_period = static_cast<double>(kRefreshEvery * n_outputs * static_cast<std::size_t>(std::max(detector.windows - 1, 1)));
+  detector_ = SequentialDetector(n_outputs, d, detector, n_outputs, long_period);
   output_used_.assign(n_outputs, 0);
   output_sum_w_.assign(n_outputs, 0.0);
   score_scratch_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d));
@@ -160,6 +177,17 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   locate_block_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nb_), static_cast<Eigen::Index>(nb_));
   locate_x_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(nb_));
   locate_llt_ = Eigen::LLT<Eigen::MatrixXd>(static_cast<Eigen::Index>(nb_));
+  if (detector_.windows() > 1) {
+    info_scratch_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
+    info_llt_ = Eigen::LLT<Eigen::MatrixXd>(static_cast<Eigen::Index>(d));
+  }
+  // The score starts once the factor's memory is full: before, the AR
+  // reference and S are estimates from a few hundred samples and the score
+  // is heavy tailed (measured: raises ~100 samples after the warm-up).
+  burn_in_ = std::max<std::uint64_t>(static_cast<std::uint64_t>(warmup_),
+                                     settings.forgetting < 1.0 ? static_cast<std::uint64_t>(std::min(1.0 / (1.0 - settings.forgetting), 1e6)) : 0);
+  refresh_last_.assign(n_outputs * detector_.windows(), burn_in_);
+  refresh_count_.assign(n_outputs * detector_.windows(), 0);
   last_good_.assign(n_outputs, 0.0);
   jump_scale_.assign(n_outputs, 0.0);
   outlier_run_.assign(n_outputs, 0);
@@ -188,6 +216,10 @@ void GrangerMonitor::reset() noexcept {
   std::fill(output_sum_w_.begin(), output_sum_w_.end(), 0.0);
   std::fill(jump_scale_.begin(), jump_scale_.end(), 0.0);
   std::fill(outlier_run_.begin(), outlier_run_.end(), 0);
+  std::fill(refresh_last_.begin(), refresh_last_.end(), burn_in_);
+  std::fill(refresh_count_.begin(), refresh_count_.end(), 0);
+  refresh_tick_ = 0;
+  refresh_cursor_ = 0;
 }
 
 void GrangerMonitor::reset_output(std::size_t j) noexcept {
@@ -201,6 +233,10 @@ void GrangerMonitor::reset_output(std::size_t j) noexcept {
   output_sum_w_[j] = 0.0;
   jump_scale_[j] = 0.0;
   outlier_run_[j] = 0;
+  for (std::size_t k = 0; k < detector_.windows(); ++k) {
+    refresh_last_[j * detector_.windows() + k] = burn_in_;
+    refresh_count_[j * detector_.windows() + k] = 0;
+  }
   mean_fast_[jj] = 0.0;
   var_fast_[jj] = 0.0;
   var_baseline_[jj] = INFINITY;
@@ -415,6 +451,40 @@ void GrangerMonitor::update_statistics() noexcept {
     }
     update_detector(j);
   }
+  refresh_long_windows();
+}
+
+void GrangerMonitor::refresh_long_windows() noexcept {
+  const std::size_t kw = detector_.windows();
+  if (kw < 2 || ++refresh_tick_ < kRefreshEvery) return;
+  refresh_tick_ = 0;
+  const std::size_t pairs = n_outputs_ * (kw - 1);
+  const std::size_t c = refresh_cursor_;
+  refresh_cursor_ = (refresh_cursor_ + 1) % pairs;
+  const std::size_t j = c / (kw - 1), k = 1 + c % (kw - 1);
+  if (j < first_output_ || j >= end_output_ || output_used_[j] <= burn_in_) return;
+  const NestedRls& reg = regressions_[j];
+  const std::size_t d = n_inputs_ * nb_;
+  if (reg.covariance_form()) {  // S = P^-1
+    reg.inputs_covariance(locate_cov_.data(), d);
+    info_llt_.compute(locate_cov_);
+    info_scratch_.setIdentity();
+    info_llt_.solveInPlace(info_scratch_);
+  } else {
+    reg.inputs_information(info_scratch_.data(), d);
+  }
+  info_scratch_ /= output_sum_w_[j];  // information per sample
+  std::uint64_t& last = refresh_last_[j * kw + k];
+  const double gap = static_cast<double>(output_used_[j] - last);
+  last = output_used_[j];
+  detector_.refresh_information(j, k, info_scratch_, gap);
+  std::uint32_t& count = refresh_count_[j * kw + k];
+  if (count < kMinRefreshes) ++count;
+  if (count < kMinRefreshes || !detector_.has_information(j, k) || loops_[j].diverging) return;
+  // T = s^T J^-1 s / sigma_W^2, both of the window's own memory.
+  const double var = detector_.variance(j, k);
+  const double t = detector_.normalised_quadratic(j, k) / var;
+  if (std::isfinite(t)) react(j, k, t, 1.0 / var);
 }
 
 void GrangerMonitor::update_detector(std::size_t j) noexcept {
@@ -428,24 +498,30 @@ void GrangerMonitor::update_detector(std::size_t j) noexcept {
     reset_output(j);
     return;
   }
-  if (output_used_[j] < static_cast<std::uint64_t>(warmup_)) return;
+  if (output_used_[j] < burn_in_) return;
   // Score of the inputs' block against the AR-only model, this sample.
   const std::size_t d = n_inputs_ * nb_;
   const double* row = reg.apriori_row();
   const double w = reg.apriori_weight();
-  detector_.accumulate(j, row, w * row[d]);
+  detector_.accumulate(j, row, w * row[d], w * row[d] * row[d]);
   if (loop.diverging) {  // no verdict on a diverging loop
     loop.alarm = false;
     return;
   }
-  const std::size_t k = detector_.next_window(j);
+  // The first window every sample (rho^2 = lambda: S is the score's own
+  // variance); the long ones when refresh_long_windows() renews them.
   const double n = output_sum_w_[j];
-  const double scale = detector_.variance_factor(k) * n * n / rss_ar;
-  const double t = scale * reg.information_quadratic(detector_.sum(j, k), score_scratch_.data());
+  const double scale = detector_.variance_factor(0) * n * n / rss_ar;
+  const double t = scale * reg.information_quadratic(detector_.sum(j, 0), score_scratch_.data());
   if (!std::isfinite(t)) {
     reset_output(j);
     return;
   }
+  react(j, 0, t, scale);
+}
+
+void GrangerMonitor::react(std::size_t j, std::size_t k, double t, double scale) noexcept {
+  LoopStats& loop = loops_[j];
   switch (detector_.test(j, k, t)) {
     case DetectorEvent::kRaised:
       ++counters_.raises;
@@ -474,7 +550,10 @@ void GrangerMonitor::locate(std::size_t j, std::size_t window, double scale) noe
   const std::size_t d = n_inputs_ * nb_;
   const auto dd = static_cast<Eigen::Index>(d);
   const auto nb = static_cast<Eigen::Index>(nb_);
-  regressions_[j].inputs_covariance(locate_cov_.data(), d);
+  // The window's own variance: S^-1 for the first window, J_W^-1 for the
+  // others (`scale` turns s^T cov s into its T).
+  if (window == 0) regressions_[j].inputs_covariance(locate_cov_.data(), d);
+  else detector_.information_inverse(j, window, locate_cov_);
   const Eigen::Map<const Eigen::VectorXd> s(detector_.sum(j, window), dd);
   locate_v_.noalias() = locate_cov_ * s;
   std::size_t best = 0;
@@ -533,6 +612,10 @@ void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
     jump_scale_[j] = part.jump_scale_[j];
     outlier_run_[j] = part.outlier_run_[j];
     detector_.adopt_output(part.detector_, j);
+    for (std::size_t k = 0; k < detector_.windows(); ++k) {
+      refresh_last_[j * detector_.windows() + k] = part.refresh_last_[j * detector_.windows() + k];
+      refresh_count_[j * detector_.windows() + k] = part.refresh_count_[j * detector_.windows() + k];
+    }
     mean_fast_[jj] = part.mean_fast_[jj];
     var_fast_[jj] = part.var_fast_[jj];
     var_baseline_[jj] = part.var_baseline_[jj];
@@ -546,6 +629,8 @@ void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
   sum_w_ = part.sum_w_;
   sum_w2_ = part.sum_w2_;
   n_eq_ = part.n_eq_;
+  refresh_tick_ = part.refresh_tick_;
+  refresh_cursor_ = part.refresh_cursor_;
 }
 
 void GrangerMonitor::full_coefficients(std::size_t output, Eigen::Ref<Eigen::VectorXd> out) const noexcept {

@@ -234,6 +234,10 @@ class GrangerMonitor {
     v(last_good_);
     v(jump_scale_);
     v(outlier_run_);
+    v(refresh_last_);
+    v(refresh_count_);
+    v(refresh_tick_);
+    v(refresh_cursor_);
     detector_.visit_state(v);
   }
 
@@ -257,6 +261,9 @@ class GrangerMonitor {
   void update_detector(std::size_t j) noexcept;
   void locate(std::size_t j, std::size_t window, double scale) noexcept;
   void reset_output(std::size_t j) noexcept;
+  void refresh_long_windows() noexcept;
+  // A statistic T of window k of output j: raise or clear, and locate.
+  void react(std::size_t j, std::size_t k, double t, double scale) noexcept;
 
   MonitorSettings settings_;
   std::size_t n_inputs_;
@@ -307,6 +314,7 @@ class GrangerMonitor {
   // Sequential detector and its per-output bookkeeping.
   SequentialDetector detector_;
   std::vector<std::uint64_t> output_used_;  // samples used since the output's (re)start
+  std::uint64_t burn_in_ = 0;               // used samples before the score starts
   std::vector<double> output_sum_w_;         // its sum of forgetting weights
   Eigen::VectorXd score_scratch_;            // m nb
   Eigen::MatrixXd locate_cov_;               // m nb x m nb, for a raise
@@ -314,6 +322,15 @@ class GrangerMonitor {
   Eigen::MatrixXd locate_block_;             // nb x nb
   Eigen::VectorXd locate_x_;                 // nb
   Eigen::LLT<Eigen::MatrixXd> locate_llt_;
+  // Long windows' information refresh: one (output, window) every few
+  // samples, round robin over every output (modelled or not, so a part of
+  // the outputs refreshes exactly as the whole monitor does).
+  Eigen::MatrixXd info_scratch_;               // m nb x m nb
+  Eigen::LLT<Eigen::MatrixXd> info_llt_;       // m nb (covariance form: S = P^-1)
+  std::vector<std::uint64_t> refresh_last_;    // output_used_ at each pair's last refresh
+  std::vector<std::uint32_t> refresh_count_;   // refreshes since the output's (re)start
+  std::uint64_t refresh_tick_ = 0;
+  std::size_t refresh_cursor_ = 0;
   // Outlier screening per output: last good residual, mean absolute one-step
   // change (clipped), consecutive rejections; and the cleaned sample.
   std::vector<double> last_good_;

@@ -358,4 +358,20 @@ void NestedRls::inputs_covariance(double* out, std::size_t ld) const noexcept {
     for (std::size_t a = 0; a < b; ++a) out[a + b * ld] = out[b + a * ld];
 }
 
+void NestedRls::inputs_information(double* out, std::size_t ld) const noexcept {
+  // S_ab = sum_i U_ia D_i U_ib over i <= min(a, b) (U unit upper, rows contiguous).
+  const std::size_t d = m_ * nb_;
+  const auto u = lower_.unit_factor();
+  const double* base = u.data();
+  const auto lu = static_cast<std::size_t>(u.outerStride());
+  const Eigen::VectorXd& dd = lower_.weights();
+  for (std::size_t b = 0; b < d; ++b)
+    for (std::size_t a = 0; a <= b; ++a) {
+      double x = 0.0;
+      for (std::size_t i = 0; i <= a; ++i) x += base[i * lu + a] * dd[static_cast<Eigen::Index>(i)] * base[i * lu + b];
+      out[a + b * ld] = x;
+      out[b + a * ld] = x;
+    }
+}
+
 }  // namespace mpm

@@ -107,6 +107,10 @@ class NestedRls {
   // lower factor's [B] block: U^T D U, or P^-1 in covariance form). `scratch`:
   // at least m nb values. Real-time safe; one triangular solve.
   double information_quadratic(const double* s, double* scratch) const noexcept;
+  // S itself (information form only: !wald_tests), m nb x m nb column major.
+  // O((m nb)^3) real-time safe: for a periodic refresh.
+  void inputs_information(double* out, std::size_t ld) const noexcept;
+  bool covariance_form() const noexcept { return wald_; }
   // S^-1 (m nb x m nb, column major, leading dimension ld). O((m nb)^3),
   // real-time safe: for a raise, not for every sample.
   void inputs_covariance(double* out, std::size_t ld) const noexcept;

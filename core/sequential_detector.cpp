@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/chi_square.hpp"
+
 namespace mpm {
 namespace {
 
@@ -54,6 +56,11 @@ double crossing_threshold(double rate, double dof, double window, double period,
   double hi = lo;
   const double target = std::log(rate);
   const auto log_rate = [&](double h) { return std::log(crossing_rate(h, dof, window, period, c)); };
+  // Never below the chi-square's 1e-3 upper quantile: the formula holds for
+  // high levels only, and a window whose share of a high stated rate would
+  // need a level in the bulk of the distribution (a long window at a rate
+  // of one alarm in 10^4 samples) contributes less than its share instead.
+  lo = std::max(lo, chi_square_quantile_upper(1e-3, dof));
   if (log_rate(lo) <= target) return lo;
   while (log_rate(hi) > target && hi < 1e6) hi *= 2.0;
   for (int it = 0; it < 200 && hi - lo > 1e-9 * hi; ++it) {
@@ -64,7 +71,7 @@ double crossing_threshold(double rate, double dof, double window, double period,
 }
 
 SequentialDetector::SequentialDetector(std::size_t outputs, std::size_t dof, const DetectorSettings& settings,
-                                       std::size_t outputs_sharing_rate)
+                                       std::size_t outputs_sharing_rate, double long_period)
     : outputs_(outputs), dof_(dof) {
   const std::vector<double>& thresholds = settings.thresholds;
   if (const std::string err = settings.validate(); !err.empty()) throw std::invalid_argument(err);
@@ -84,7 +91,7 @@ SequentialDetector::SequentialDetector(std::size_t outputs, std::size_t dof, con
     window_[w] = settings.first_window * std::pow(settings.window_ratio, static_cast<double>(w));
     rho_[w] = 1.0 - 1.0 / window_[w];
     var_factor_[w] = 1.0 - rho_[w] * rho_[w];
-    threshold_[w] = thresholds.empty() ? crossing_threshold(share, d, window_[w], static_cast<double>(k), settings.crossing_constant)
+    threshold_[w] = thresholds.empty() ? crossing_threshold(share, d, window_[w], w == 0 ? 1.0 : long_period, settings.crossing_constant)
                                        : thresholds[static_cast<std::size_t>(w)];
     if (!(std::isfinite(threshold_[w]) && threshold_[w] > 0.0))
       throw std::invalid_argument("detector thresholds must be finite and > 0");
@@ -94,23 +101,36 @@ SequentialDetector::SequentialDetector(std::size_t outputs, std::size_t dof, con
   last_.assign(outputs * static_cast<std::size_t>(k), 0.0);
   raised_.assign(outputs, 0);
   cursor_.assign(outputs, 0);
+  info_.assign(outputs * static_cast<std::size_t>(k), Eigen::MatrixXd());
+  chol_.assign(outputs * static_cast<std::size_t>(k), Eigen::LLT<Eigen::MatrixXd>());
+  for (std::size_t j = 0; j < outputs; ++j)
+    for (Eigen::Index w = 1; w < k; ++w) {
+      info_[j * static_cast<std::size_t>(k) + static_cast<std::size_t>(w)] = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(dof), static_cast<Eigen::Index>(dof));
+      chol_[j * static_cast<std::size_t>(k) + static_cast<std::size_t>(w)] = Eigen::LLT<Eigen::MatrixXd>(static_cast<Eigen::Index>(dof));
+    }
+  info_ok_.assign(outputs * static_cast<std::size_t>(k), 0);
+  var_.assign(outputs * static_cast<std::size_t>(k), 0.0);
+  var_norm_.assign(outputs * static_cast<std::size_t>(k), 0.0);
+  solve_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(dof));
   reset();
 }
 
-void SequentialDetector::accumulate(std::size_t j, const double* x, double scale) noexcept {
+void SequentialDetector::accumulate(std::size_t j, const double* x, double scale, double squared_error) noexcept {
   const std::size_t kw = windows();
   const auto d = static_cast<Eigen::Index>(dof_);
   for (std::size_t w = 0; w < kw; ++w) {
+    const double r2 = rho_[static_cast<Eigen::Index>(w)] * rho_[static_cast<Eigen::Index>(w)];
+    var_[j * kw + w] = r2 * var_[j * kw + w] + squared_error;
+    var_norm_[j * kw + w] = r2 * var_norm_[j * kw + w] + 1.0;
     double* s = sums_.col(static_cast<Eigen::Index>(j * kw + w)).data();
     const double r = rho_[static_cast<Eigen::Index>(w)];
     for (Eigen::Index i = 0; i < d; ++i) s[i] = r * s[i] + scale * x[i];
   }
 }
 
-std::size_t SequentialDetector::next_window(std::size_t j) noexcept {
-  const std::size_t w = cursor_[j];
-  cursor_[j] = static_cast<std::uint32_t>((w + 1) % windows());
-  return w;
+void SequentialDetector::information_inverse(std::size_t j, std::size_t k, Eigen::MatrixXd& out) const noexcept {
+  out.setIdentity();
+  chol_[j * windows() + k].solveInPlace(out);
 }
 
 DetectorEvent SequentialDetector::test(std::size_t j, std::size_t k, double t) noexcept {
@@ -143,9 +163,35 @@ void SequentialDetector::reset_output(std::size_t j) noexcept {
   for (std::size_t w = 0; w < kw; ++w) {
     sums_.col(static_cast<Eigen::Index>(j * kw + w)).setZero();
     last_[j * kw + w] = 0.0;
+    if (!var_.empty()) var_[j * kw + w] = var_norm_[j * kw + w] = 0.0;
   }
   raised_[j] = 0;
   cursor_[j] = 0;
+  for (std::size_t w = 1; w < kw; ++w) {
+    info_[j * kw + w].setZero();
+    info_ok_[j * kw + w] = 0;
+  }
+}
+
+void SequentialDetector::refresh_information(std::size_t j, std::size_t k, const Eigen::MatrixXd& per_sample,
+                                             double gap) noexcept {
+  const std::size_t i = j * windows() + k;
+  const double r2 = rho_[static_cast<Eigen::Index>(k)] * rho_[static_cast<Eigen::Index>(k)];
+  const double decay = std::pow(r2, gap);
+  // The samples since the last refresh, each with its weight rho^2j, carry
+  // the current per-sample information.
+  const double weight = (1.0 - decay) / (1.0 - r2);
+  info_[i] *= decay;
+  info_[i].noalias() += weight * per_sample;
+  chol_[i].compute(info_[i]);
+  info_ok_[i] = chol_[i].info() == Eigen::Success ? 1 : 0;
+}
+
+double SequentialDetector::normalised_quadratic(std::size_t j, std::size_t k) noexcept {
+  const std::size_t i = j * windows() + k;
+  solve_ = sums_.col(static_cast<Eigen::Index>(i));
+  chol_[i].matrixL().solveInPlace(solve_);
+  return solve_.squaredNorm();
 }
 
 void SequentialDetector::reset() noexcept {
@@ -157,9 +203,16 @@ void SequentialDetector::adopt_output(const SequentialDetector& part, std::size_
   for (std::size_t w = 0; w < kw; ++w) {
     sums_.col(static_cast<Eigen::Index>(j * kw + w)) = part.sums_.col(static_cast<Eigen::Index>(j * kw + w));
     last_[j * kw + w] = part.last_[j * kw + w];
+    var_[j * kw + w] = part.var_[j * kw + w];
+    var_norm_[j * kw + w] = part.var_norm_[j * kw + w];
   }
   raised_[j] = part.raised_[j];
   cursor_[j] = part.cursor_[j];
+  for (std::size_t w = 1; w < kw; ++w) {
+    info_[j * kw + w] = part.info_[j * kw + w];
+    info_ok_[j * kw + w] = part.info_ok_[j * kw + w];
+    chol_[j * kw + w] = part.chol_[j * kw + w];
+  }
 }
 
 }  // namespace mpm

@@ -89,10 +89,11 @@ class SequentialDetector {
  public:
   SequentialDetector() = default;
   // outputs x windows sums of `dof` values each; thresholds from the stated
-  // rate shared by `outputs_sharing_rate` outputs, with the windows looked
-  // at round robin (period = windows), or settings.thresholds when given.
+  // rate shared by `outputs_sharing_rate` outputs, the first window looked
+  // at every sample and the others every `long_period` samples, or
+  // settings.thresholds when given.
   SequentialDetector(std::size_t outputs, std::size_t dof, const DetectorSettings& settings,
-                     std::size_t outputs_sharing_rate);
+                     std::size_t outputs_sharing_rate, double long_period);
 
   std::size_t windows() const noexcept { return static_cast<std::size_t>(window_.size()); }
   std::size_t dof() const noexcept { return dof_; }
@@ -102,13 +103,35 @@ class SequentialDetector {
   // 1 - rho_W^2: the factor that makes T_W chi-square.
   double variance_factor(std::size_t k) const noexcept { return var_factor_[static_cast<Eigen::Index>(k)]; }
 
-  // Real-time safe: s_W <- rho_W s_W + scale * x for every window of output j.
-  void accumulate(std::size_t j, const double* x, double scale) noexcept;
-  // The window to look at next for output j (advances the round robin).
-  std::size_t next_window(std::size_t j) noexcept;
+  // Real-time safe: s_W <- rho_W s_W + scale * x for every window of output
+  // j, and the window's noise variance from the squared prediction error
+  // (weighted, w e^2) with weights rho_W^2: a long window normalised by a
+  // variance of shorter memory would cross as often as that memory's
+  // fluctuations, whatever its own length (measured: crossing constants
+  // growing ~W).
+  void accumulate(std::size_t j, const double* x, double scale, double squared_error) noexcept;
+  // The window's noise variance (sigma_W^2).
+  double variance(std::size_t j, std::size_t k) const noexcept {
+    const std::size_t i = j * windows() + k;
+    return var_norm_[i] > 0.0 ? var_[i] / var_norm_[i] : 0.0;
+  }
   const double* sum(std::size_t j, std::size_t k) const noexcept {
     return sums_.col(static_cast<Eigen::Index>(j * windows() + k)).data();
   }
+  // Windows past the first are normalised by their own information J_W (the
+  // ρ_W^2-weighted average of the per-sample information S/n, refreshed
+  // every so often): S alone has the factor's memory, and a window much
+  // longer than it, normalised by S, saw its statistic inflated by the
+  // excitation of setpoint steps S had forgotten (measured by mpm
+  // calibrate: crossing constants 6..1400 instead of ~1). Real-time safe.
+  // per_sample: d x d information per sample; gap: samples since the last refresh.
+  void refresh_information(std::size_t j, std::size_t k, const Eigen::MatrixXd& per_sample, double gap) noexcept;
+  bool has_information(std::size_t j, std::size_t k) const noexcept { return info_ok_[j * windows() + k] != 0; }
+  // s_W^T J_W^-1 s_W (window k >= 1, has_information). Real-time safe.
+  double normalised_quadratic(std::size_t j, std::size_t k) noexcept;
+  // J_W^-1 into out (dof x dof, column major; has_information). O(dof^3),
+  // real-time safe: for a raise.
+  void information_inverse(std::size_t j, std::size_t k, Eigen::MatrixXd& out) const noexcept;
   // Records T for window k of output j. Real-time safe.
   DetectorEvent test(std::size_t j, std::size_t k, double t) noexcept;
 
@@ -129,6 +152,10 @@ class SequentialDetector {
     v(last_);
     v(raised_);
     v(cursor_);
+    v(var_);
+    v(var_norm_);
+    for (Eigen::MatrixXd& m : info_) v(m);
+    v(info_ok_);
   }
 
  private:
@@ -139,6 +166,11 @@ class SequentialDetector {
   std::vector<double> last_;        // outputs * windows
   std::vector<std::uint8_t> raised_;
   std::vector<std::uint32_t> cursor_;
+  std::vector<double> var_, var_norm_;           // per (output, window)
+  std::vector<Eigen::MatrixXd> info_;           // J_W per (output, window >= 1)
+  std::vector<std::uint8_t> info_ok_;
+  std::vector<Eigen::LLT<Eigen::MatrixXd>> chol_;  // its Cholesky factor (derived: not state)
+  Eigen::VectorXd solve_;                       // scratch, dof
 };
 
 }  // namespace mpm
