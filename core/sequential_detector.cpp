@@ -56,11 +56,11 @@ double crossing_threshold(double rate, double dof, double window, double period,
   double hi = lo;
   const double target = std::log(rate);
   const auto log_rate = [&](double h) { return std::log(crossing_rate(h, dof, window, period, c)); };
-  // Never below the chi-square's 1e-3 upper quantile: the formula holds for
+  // Never below the chi-square's 1e-2 upper quantile: the formula holds for
   // high levels only, and a window whose share of a high stated rate would
   // need a level in the bulk of the distribution (a long window at a rate
   // of one alarm in 10^4 samples) contributes less than its share instead.
-  lo = std::max(lo, chi_square_quantile_upper(1e-3, dof));
+  lo = std::max(lo, chi_square_quantile_upper(1e-2, dof));
   if (log_rate(lo) <= target) return lo;
   while (log_rate(hi) > target && hi < 1e6) hi *= 2.0;
   for (int it = 0; it < 200 && hi - lo > 1e-9 * hi; ++it) {

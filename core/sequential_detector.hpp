@@ -56,7 +56,7 @@
 namespace mpm {
 
 // Fitted by simulation of the ideal chi-square process (see the overview).
-inline constexpr double kCrossingConstant = 1.2;
+inline constexpr double kCrossingConstant = 0.7;
 inline constexpr double kOvershootBeta = 3.5;
 
 struct DetectorSettings {

@@ -11,9 +11,10 @@
 namespace mpm {
 
 NullRun null_alarm_run(const PlantModel& plant, const MonitorSettings& settings, std::uint64_t seed,
-                       std::size_t samples, const std::vector<std::vector<double>>& levels) {
-  const sim::Scenario* sc = sim::find_scenario("plant-nominal");
-  if (!sc) throw std::invalid_argument("no plant-nominal scenario");
+                       std::size_t samples, const std::vector<std::vector<double>>& levels,
+                       const std::string& scenario) {
+  const sim::Scenario* sc = sim::find_scenario(scenario);
+  if (!sc) throw std::invalid_argument("no scenario " + scenario);
   sim::ClosedLoop loop(plant, sim::scenario_loop(*sc, plant), seed);
   const config::Recording rec = sim::simulate(loop, samples, "null");
   const config::BoundRecording bound = config::bind(plant, rec);
@@ -36,7 +37,14 @@ NullRun null_alarm_run(const PlantModel& plant, const MonitorSettings& settings,
     ++out.samples;
     for (std::size_t j = 0; j < p; ++j) {
       const bool now = monitor.loop(j).alarm;
-      if (now && !raised[j]) out.raises.push_back(out.samples - 1);
+      if (now && !raised[j]) {
+        out.raises.push_back(out.samples - 1);
+        out.raised_outputs.push_back(j);
+        std::size_t named = plant.n_inputs();
+        for (std::size_t i = 0; i < plant.n_inputs(); ++i)
+          if (monitor.channel(j, i).alarm) named = i;
+        out.raised_inputs.push_back(named);
+      }
       raised[j] = now ? 1 : 0;
       for (std::size_t k = 0; k < kw && k < levels.size(); ++k)
         for (std::size_t l = 0; l < levels[k].size() && l < 8; ++l) {
