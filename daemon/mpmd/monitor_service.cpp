@@ -304,8 +304,9 @@ void MonitorService::fill_status(msg::Status& out, std::int64_t utime, std::int6
   out.uptime_ms = uptime_ms;
   out.ready = monitor_.ready();
   out.effective_samples = monitor_.effective_samples();
-  out.raise_threshold = monitor_.raise_threshold();
-  out.clear_threshold = monitor_.clear_threshold();
+  // The live detector's levels (its first window's: the others are in the log).
+  out.raise_threshold = monitor_.detector().threshold(0);
+  out.clear_threshold = monitor_.detector().clear_level(0);
   out.samples_seen = static_cast<std::int64_t>(counters_.seen);
   out.samples_used = static_cast<std::int64_t>(mc.used);
   out.dropped = static_cast<std::int64_t>(counters_.dropped);
