@@ -34,7 +34,11 @@ constexpr std::uint64_t kOutlierLearn = 50;
 // the first (exactly self-normalised) window runs.
 constexpr std::size_t kLongWindowMaxDof = 100;
 // One long window's information refreshed every this many samples.
-constexpr std::uint64_t kRefreshEvery = 32;
+constexpr std::uint64_t kRefreshEvery = 64;
+// The first window of an output is looked at every this many samples
+// (outputs staggered): its memory is thousands of samples, and one
+// triangular solve per output and sample cost ~40 % of the 2x2 update.
+constexpr std::uint64_t kFirstWindowEvery = 4;
 // A long window is tested once its information has had this many refreshes:
 // before, J_W is a few snapshots of S against a score summed over
 // everything in between (measured: raises at the first refreshes).
@@ -168,7 +172,8 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   // Long windows are looked at when their information is refreshed: one
   // (output, window) every kRefreshEvery samples, round robin.
   const double long_period = static_cast<double>(kRefreshEvery * n_outputs * static_cast<std::size_t>(std::max(detector.windows - 1, 1)));
-  detector_ = SequentialDetector(n_outputs, d, detector, n_outputs, long_period);
+  detector_ = SequentialDetector(n_outputs, d, detector, n_outputs, long_period,
+                                 static_cast<double>(kFirstWindowEvery));
   output_used_.assign(n_outputs, 0);
   output_sum_w_.assign(n_outputs, 0.0);
   score_scratch_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d));
@@ -510,6 +515,7 @@ void GrangerMonitor::update_detector(std::size_t j) noexcept {
   }
   // The first window every sample (rho^2 = lambda: S is the score's own
   // variance); the long ones when refresh_long_windows() renews them.
+  if ((output_used_[j] + j) % kFirstWindowEvery != 0) return;
   const double n = output_sum_w_[j];
   const double scale = detector_.variance_factor(0) * n * n / rss_ar;
   const double t = scale * reg.information_quadratic(detector_.sum(j, 0), score_scratch_.data());

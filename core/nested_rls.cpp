@@ -359,19 +359,20 @@ void NestedRls::inputs_covariance(double* out, std::size_t ld) const noexcept {
 }
 
 void NestedRls::inputs_information(double* out, std::size_t ld) const noexcept {
-  // S_ab = sum_i U_ia D_i U_ib over i <= min(a, b) (U unit upper, rows contiguous).
-  const std::size_t d = m_ * nb_;
+  // S = U^T D U over the inputs' block (U unit upper): row i of D U is D_i
+  // times row i of U, so S = sum_i D_i u_i^T u_i, one rank-one update per row
+  // on the upper triangle (row i of U is zero before column i), mirrored.
+  const auto d = static_cast<Eigen::Index>(m_ * nb_);
   const auto u = lower_.unit_factor();
-  const double* base = u.data();
-  const auto lu = static_cast<std::size_t>(u.outerStride());
   const Eigen::VectorXd& dd = lower_.weights();
-  for (std::size_t b = 0; b < d; ++b)
-    for (std::size_t a = 0; a <= b; ++a) {
-      double x = 0.0;
-      for (std::size_t i = 0; i <= a; ++i) x += base[i * lu + a] * dd[static_cast<Eigen::Index>(i)] * base[i * lu + b];
-      out[a + b * ld] = x;
-      out[b + a * ld] = x;
-    }
+  Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> s(out, d, d, Eigen::OuterStride<>(static_cast<Eigen::Index>(ld)));
+  s.setZero();
+  for (Eigen::Index i = 0; i < d; ++i) {
+    const auto row = u.row(i).segment(i, d - i);
+    for (Eigen::Index b = i; b < d; ++b) s.col(b).segment(i, b - i + 1).noalias() += (dd[i] * row[b - i]) * row.head(b - i + 1).transpose();
+  }
+  for (Eigen::Index b = 0; b < d; ++b)
+    for (Eigen::Index a = b + 1; a < d; ++a) s(a, b) = s(b, a);
 }
 
 }  // namespace mpm

@@ -71,7 +71,7 @@ double crossing_threshold(double rate, double dof, double window, double period,
 }
 
 SequentialDetector::SequentialDetector(std::size_t outputs, std::size_t dof, const DetectorSettings& settings,
-                                       std::size_t outputs_sharing_rate, double long_period)
+                                       std::size_t outputs_sharing_rate, double long_period, double first_period)
     : outputs_(outputs), dof_(dof) {
   const std::vector<double>& thresholds = settings.thresholds;
   if (const std::string err = settings.validate(); !err.empty()) throw std::invalid_argument(err);
@@ -91,7 +91,7 @@ SequentialDetector::SequentialDetector(std::size_t outputs, std::size_t dof, con
     window_[w] = settings.first_window * std::pow(settings.window_ratio, static_cast<double>(w));
     rho_[w] = 1.0 - 1.0 / window_[w];
     var_factor_[w] = 1.0 - rho_[w] * rho_[w];
-    threshold_[w] = thresholds.empty() ? crossing_threshold(share, d, window_[w], w == 0 ? 1.0 : long_period, settings.crossing_constant)
+    threshold_[w] = thresholds.empty() ? crossing_threshold(share, d, window_[w], w == 0 ? first_period : long_period, settings.crossing_constant)
                                        : thresholds[static_cast<std::size_t>(w)];
     if (!(std::isfinite(threshold_[w]) && threshold_[w] > 0.0))
       throw std::invalid_argument("detector thresholds must be finite and > 0");

@@ -90,10 +90,10 @@ class SequentialDetector {
   SequentialDetector() = default;
   // outputs x windows sums of `dof` values each; thresholds from the stated
   // rate shared by `outputs_sharing_rate` outputs, the first window looked
-  // at every sample and the others every `long_period` samples, or
+  // at every `first_period` samples and the others every `long_period`, or
   // settings.thresholds when given.
   SequentialDetector(std::size_t outputs, std::size_t dof, const DetectorSettings& settings,
-                     std::size_t outputs_sharing_rate, double long_period);
+                     std::size_t outputs_sharing_rate, double long_period, double first_period = 1.0);
 
   std::size_t windows() const noexcept { return static_cast<std::size_t>(window_.size()); }
   std::size_t dof() const noexcept { return dof_; }
