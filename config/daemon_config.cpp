@@ -42,16 +42,19 @@ void read(const YamlReader& r, const Field& map, const char* key, std::string& o
 void read_monitor(const YamlReader& r, const Field& root, DaemonConfig& c) {
   const Field m = r.child(root, "monitor");
   if (!m.present() || m.node.IsNull()) return;
-  r.check_keys(m, {"ar_order", "input_order", "forgetting", "false_alarm", "clear_ratio", "raise_after",
-                   "clear_after", "warmup", "gamma_lambda", "input_pole", "regressors", "settle_samples"});
+  r.check_keys(m, {"ar_order", "input_order", "forgetting", "false_alarm", "false_alarms_per_year", "sample_time",
+                   "crossing_constant", "detector_thresholds", "outlier_limit", "warmup", "gamma_lambda", "input_pole", "regressors",
+                   "settle_samples"});
   MonitorSettings& s = c.monitor;
   read(r, m, "ar_order", s.ar_order);
   read(r, m, "input_order", s.input_order);
   read(r, m, "forgetting", s.forgetting);
   read(r, m, "false_alarm", s.false_alarm);
-  read(r, m, "clear_ratio", s.clear_ratio);
-  read(r, m, "raise_after", s.raise_after);
-  read(r, m, "clear_after", s.clear_after);
+  read(r, m, "false_alarms_per_year", s.detector.false_alarms_per_year);
+  read(r, m, "sample_time", s.detector.sample_time);
+  read(r, m, "crossing_constant", s.detector.crossing_constant);
+  read(r, m, "outlier_limit", s.outlier_limit);
+  if (const Field t = r.child(m, "detector_thresholds"); t.present()) s.detector.thresholds = r.numbers(t);
   read(r, m, "warmup", s.warmup);
   read(r, m, "gamma_lambda", s.gamma_lambda);
   const Field pole = r.child(m, "input_pole");

@@ -7,7 +7,8 @@
 //   controller_id: wood-berry-1
 //   plant: wood-berry.yaml          # relative to this file's folder
 //   monitor: {ar_order: 10, input_order: 10, forgetting: 0.999, false_alarm: 1e-3,
-//             clear_ratio: 0.5, raise_after: 20, clear_after: 100, warmup: 0,
+//             false_alarms_per_year: 1, sample_time: 0 (= the plant's),
+//             crossing_constant: 1.2 (from mpm calibrate), outlier_limit: 10, warmup: 0,
 //             gamma_lambda: 0.1, input_pole: 0, regressors: model_filtered,
 //             settle_samples: auto}
 //   transport:

@@ -235,4 +235,29 @@ Eigen::MatrixXd BiermanRls::covariance() const {
   return u * d_.asDiagonal() * u.transpose();
 }
 
+double BiermanRls::covariance_quadratic(const double* s) const noexcept {
+  // s^T U D U^T s = sum_j D_j (s_j + sum_{i<j} U_ij s_i)^2.
+  double q = 0.0;
+  for (std::size_t j = 0; j < p_; ++j) {
+    const double* col = u_.data() + column_[static_cast<Eigen::Index>(j)];
+    double v = s[j];
+    for (std::size_t i = 0; i < j; ++i) v += col[i] * s[i];
+    q += d_[static_cast<Eigen::Index>(j)] * v * v;
+  }
+  return q;
+}
+
+void BiermanRls::covariance_into(double* out, std::size_t ld) const noexcept {
+  const auto unit = [&](std::size_t i, std::size_t j) {
+    return i == j ? 1.0 : i < j ? u_[static_cast<Eigen::Index>(column_[static_cast<Eigen::Index>(j)] + i)] : 0.0;
+  };
+  for (std::size_t a = 0; a < p_; ++a)
+    for (std::size_t b = a; b < p_; ++b) {
+      double v = 0.0;
+      for (std::size_t j = b; j < p_; ++j) v += unit(a, j) * d_[static_cast<Eigen::Index>(j)] * unit(b, j);
+      out[a + b * ld] = v;
+      out[b + a * ld] = v;
+    }
+}
+
 }  // namespace mpm

@@ -67,7 +67,27 @@ class BiermanRls {
   const Eigen::VectorXd& coefficients() const noexcept { return theta_; }
   // P = U D U^T as a dense matrix (allocates; for tests).
   Eigen::MatrixXd covariance() const;
+  // s^T P s (the sequential detector's normalisation): one pass over U.
+  // Real-time safe.
+  double covariance_quadratic(const double* s) const noexcept;
+  // P into out (p x p, column major, leading dimension ld). O(p^3), real-time
+  // safe (for a raise, not every sample).
+  void covariance_into(double* out, std::size_t ld) const noexcept;
   void reset() noexcept;
+
+  // Every member that changes after setup (for checkpointing).
+  template <class V>
+  void visit_state(V&& v) {
+    v(since_prior_);
+    v(next_prior_row_);
+    v(u_);
+    v(d_);
+    v(theta_);
+    v(block_cov_);
+    v(next_resync_);
+    v(rss_);
+    v(energy_);
+  }
 
  private:
   std::size_t p_ = 0;

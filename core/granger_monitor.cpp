@@ -24,6 +24,29 @@ constexpr std::size_t kWaldMinInputs = 4;
 constexpr double kDivergenceOverReference = 100.0;
 constexpr double kDivergenceRatio = 1e3;
 constexpr double kFastMemory = 0.99;  // ~100-sample variance estimate
+// Outlier screening: the mean absolute one-step change of the residual is
+// learnt over this many samples before any is rejected, then followed with
+// a ~200-sample memory (clipped at the limit, so an outlier cannot inflate
+// it); this many consecutive rejections are a level shift, accepted.
+constexpr std::uint64_t kOutlierLearn = 50;
+// Long detector windows need their own information matrix (d x d per
+// window and output): kept up to this many input regressors; beyond, only
+// the first (exactly self-normalised) window runs.
+constexpr std::size_t kLongWindowMaxDof = 100;
+// One long window's information refreshed every this many samples.
+constexpr std::uint64_t kRefreshEvery = 64;
+// The first window of an output is looked at every this many samples
+// (outputs staggered): its memory is thousands of samples, and one
+// triangular solve per output and sample cost ~40 % of the 2x2 update.
+constexpr std::uint64_t kFirstWindowEvery = 4;
+// A long window is tested once its information has had this many refreshes:
+// before, J_W is a few snapshots of S against a score summed over
+// everything in between (measured: raises at the first refreshes).
+constexpr std::uint32_t kMinRefreshes = 8;
+constexpr double kJumpMemory = 0.995;
+constexpr int kOutlierRunAccept = 5;
+// Mean absolute value of a standard normal: mean |change| / this = sigma.
+constexpr double kMeanAbsNormal = 0.7978845608;
 
 bool finite_all(const double* v, std::size_t n) noexcept {
   for (std::size_t i = 0; i < n; ++i)
@@ -39,9 +62,9 @@ std::string MonitorSettings::validate() const {
   if (input_order < 1 || input_order > 200) e << "input_order must be in [1, 200], got " << input_order << "; ";
   if (!(forgetting > 0.9 && forgetting <= 1.0)) e << "forgetting must be in (0.9, 1], got " << forgetting << "; ";
   if (!(false_alarm > 0.0 && false_alarm < 0.5)) e << "false_alarm must be in (0, 0.5), got " << false_alarm << "; ";
-  if (!(clear_ratio > 0.0 && clear_ratio <= 1.0)) e << "clear_ratio must be in (0, 1], got " << clear_ratio << "; ";
-  if (raise_after < 1) e << "raise_after must be >= 1, got " << raise_after << "; ";
-  if (clear_after < 1) e << "clear_after must be >= 1, got " << clear_after << "; ";
+  if (!(outlier_limit == 0.0 || (outlier_limit >= 3.0 && outlier_limit <= 1e6)))
+    e << "outlier_limit must be 0 (off) or in [3, 1e6], got " << outlier_limit << "; ";
+  e << detector.validate();
   if (warmup < 0) e << "warmup must be >= 0, got " << warmup << "; ";
   if (!(input_pole >= 0.0 && input_pole < 0.99)) e << "input_pole must be in [0, 0.99), got " << input_pole << "; ";
   if (!(gamma_lambda > 0.0)) e << "gamma_lambda must be > 0, got " << gamma_lambda << "; ";
@@ -130,9 +153,50 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
 
   const double dof = static_cast<double>(nb_);
   lr_raise_ = chi_square_quantile_upper(settings.false_alarm, dof);
-  lr_clear_ = settings.clear_ratio * lr_raise_;
   lr_joint_raise_ = chi_square_quantile_upper(settings.false_alarm, dof * static_cast<double>(n_inputs));
-  lr_joint_clear_ = settings.clear_ratio * lr_joint_raise_;
+  score_raise_ = lr_raise_;
+  // The stated rate is the whole controller's: shared by all its outputs,
+  // also when this monitor models only a part of them.
+  const std::size_t d = n_inputs * nb_;
+  // The shortest memory is the one whose squared weights equal the factor's
+  // (rho^2 = lambda): there S is exactly the score's conditional variance,
+  // however the inputs moved, so T is chi-square even across setpoint steps
+  // (measured: shorter windows normalised by S raise on every step).
+  DetectorSettings detector = settings.detector;
+  if (d > kLongWindowMaxDof) {
+    detector.windows = 1;
+    if (detector.thresholds.size() > 1) detector.thresholds.erase(detector.thresholds.begin() + 1, detector.thresholds.end());
+  }
+  if (detector.first_window == 0.0)
+    detector.first_window = settings.forgetting < 1.0 ? std::min(2.0 / (1.0 - settings.forgetting), 1e6) : 2000.0;
+  // Long windows are looked at when their information is refreshed: one
+  // (output, window) every kRefreshEvery samples, round robin.
+  const double long_period = static_cast<double>(kRefreshEvery * n_outputs * static_cast<std::size_t>(std::max(detector.windows - 1, 1)));
+  detector_ = SequentialDetector(n_outputs, d, detector, n_outputs, long_period,
+                                 static_cast<double>(kFirstWindowEvery));
+  output_used_.assign(n_outputs, 0);
+  output_sum_w_.assign(n_outputs, 0.0);
+  score_scratch_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d));
+  locate_cov_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
+  locate_v_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d));
+  locate_block_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nb_), static_cast<Eigen::Index>(nb_));
+  locate_x_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(nb_));
+  locate_llt_ = Eigen::LLT<Eigen::MatrixXd>(static_cast<Eigen::Index>(nb_));
+  if (detector_.windows() > 1) {
+    info_scratch_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
+    info_llt_ = Eigen::LLT<Eigen::MatrixXd>(static_cast<Eigen::Index>(d));
+  }
+  // The score starts once the factor's memory is full: before, the AR
+  // reference and S are estimates from a few hundred samples and the score
+  // is heavy tailed (measured: raises ~100 samples after the warm-up).
+  burn_in_ = std::max<std::uint64_t>(static_cast<std::uint64_t>(warmup_),
+                                     settings.forgetting < 1.0 ? static_cast<std::uint64_t>(std::min(1.0 / (1.0 - settings.forgetting), 1e6)) : 0);
+  refresh_last_.assign(n_outputs * detector_.windows(), burn_in_);
+  refresh_count_.assign(n_outputs * detector_.windows(), 0);
+  last_good_.assign(n_outputs, 0.0);
+  jump_scale_.assign(n_outputs, 0.0);
+  outlier_run_.assign(n_outputs, 0);
+  clean_.assign(n_outputs, 0.0);
   reset();
 }
 
@@ -152,6 +216,41 @@ void GrangerMonitor::reset() noexcept {
   var_baseline_.setConstant(INFINITY);
   for (auto& c : channels_) c.gamma = NAN;
   used_since_reset_ = 0;
+  detector_.reset();
+  std::fill(output_used_.begin(), output_used_.end(), 0);
+  std::fill(output_sum_w_.begin(), output_sum_w_.end(), 0.0);
+  std::fill(jump_scale_.begin(), jump_scale_.end(), 0.0);
+  std::fill(outlier_run_.begin(), outlier_run_.end(), 0);
+  std::fill(refresh_last_.begin(), refresh_last_.end(), burn_in_);
+  std::fill(refresh_count_.begin(), refresh_count_.end(), 0);
+  refresh_tick_ = 0;
+  refresh_cursor_ = 0;
+}
+
+void GrangerMonitor::reset_output(std::size_t j) noexcept {
+  // Non-finite statistics (an input of 1e300, a factor that overflowed):
+  // this output starts again from its prior; the others keep theirs.
+  const auto jj = static_cast<Eigen::Index>(j);
+  regressions_[j].reset();
+  residual_lags_.col(jj).setZero();
+  detector_.reset_output(j);
+  output_used_[j] = 0;
+  output_sum_w_[j] = 0.0;
+  jump_scale_[j] = 0.0;
+  outlier_run_[j] = 0;
+  for (std::size_t k = 0; k < detector_.windows(); ++k) {
+    refresh_last_[j * detector_.windows() + k] = burn_in_;
+    refresh_count_[j * detector_.windows() + k] = 0;
+  }
+  mean_fast_[jj] = 0.0;
+  var_fast_[jj] = 0.0;
+  var_baseline_[jj] = INFINITY;
+  loops_[j] = LoopStats{};
+  for (std::size_t i = 0; i < n_inputs_; ++i) {
+    channels_[j * n_inputs_ + i] = ChannelStats{};
+    channels_[j * n_inputs_ + i].gamma = NAN;
+  }
+  ++counters_.resets;
 }
 
 bool GrangerMonitor::ready() const noexcept { return used_since_reset_ >= static_cast<std::uint64_t>(warmup_); }
@@ -184,6 +283,11 @@ SampleStatus GrangerMonitor::update(const double* u, const double* residual) noe
   }
   SampleStatus status = SampleStatus::kWarmingUp;
   if (lags_filled_ >= lags_needed_) {
+    if (screen_outliers(residual)) {
+      ++counters_.outliers;
+      push_lags(u, clean_.data());
+      return SampleStatus::kOutlier;
+    }
     absorb_sample(residual);
     ++counters_.used;
     ++used_since_reset_;
@@ -193,6 +297,43 @@ SampleStatus GrangerMonitor::update(const double* u, const double* residual) noe
   }
   push_lags(u, residual);
   return status;
+}
+
+bool GrangerMonitor::screen_outliers(const double* residual) noexcept {
+  if (settings_.outlier_limit == 0.0) return false;
+  bool outlier = false;
+  for (std::size_t j = first_output_; j < end_output_; ++j) {
+    clean_[j] = residual[j];
+    const double jump = std::abs(residual[j] - last_good_[j]);
+    const std::uint64_t n = output_used_[j];
+    double& scale = jump_scale_[j];  // mean |one-step change|
+    if (n == 0) {  // first sample after a (re)start: nothing to compare with
+      last_good_[j] = residual[j];
+      continue;
+    }
+    if (n < kOutlierLearn) {  // learning the scale: plain running mean
+      scale += (jump - scale) / static_cast<double>(n);
+      last_good_[j] = residual[j];
+      continue;
+    }
+    const double limit = settings_.outlier_limit * scale / kMeanAbsNormal;
+    if (jump > limit && outlier_run_[j] < kOutlierRunAccept) {
+      ++outlier_run_[j];
+      clean_[j] = last_good_[j];
+      outlier = true;
+      continue;
+    }
+    outlier_run_[j] = 0;
+    scale = kJumpMemory * scale + (1.0 - kJumpMemory) * std::min(jump, limit);
+    last_good_[j] = residual[j];
+  }
+  if (outlier) {
+    // Nothing of this sample enters any output's statistics; the outputs
+    // that were fine keep their value as the last good one.
+    for (std::size_t j = first_output_; j < end_output_; ++j)
+      if (clean_[j] == residual[j] && outlier_run_[j] == 0) last_good_[j] = residual[j];
+  }
+  return outlier;
 }
 
 void GrangerMonitor::absorb_sample(const double* residual) noexcept {
@@ -272,7 +413,6 @@ void GrangerMonitor::update_statistics() noexcept {
   const std::size_t p_pair = 1 + na_ + nb_;
   const double scale_full = std::max(n_eq_ - static_cast<double>(p_full), 1.0);
   const double scale_pair = std::max(n_eq_ - static_cast<double>(p_pair), 1.0);
-  const bool testing = ready();
   for (std::size_t j = first_output_; j < end_output_; ++j) {
     const NestedRls& reg = regressions_[j];
     LoopStats& loop = loops_[j];
@@ -295,7 +435,6 @@ void GrangerMonitor::update_statistics() noexcept {
     loop.lr_joint = scale_full * log_ratios_[0];
     // The AR parts of every pairwise model, for gamma, in one solve.
     const Eigen::MatrixXd* pair_prefix = n_inverse_ar_[j] ? &reg.solve_pairs_prefix() : nullptr;
-    bool any_channel = false;
     for (std::size_t i = 0; i < n_inputs_; ++i) {
       const auto ii = static_cast<Eigen::Index>(i);
       ChannelStats& c = channels_[j * n_inputs_ + i];
@@ -313,43 +452,147 @@ void GrangerMonitor::update_statistics() noexcept {
         const double dist = (g_hat - g_n).squaredNorm();
         c.gamma = dist / (1.0 + g_n.squaredNorm());
       }
-      if (testing) update_hysteresis(c, c.lr_conditional, lr_raise_, lr_clear_, c.alarm);
       if (loop.diverging) c.alarm = false;  // no verdict on a diverging loop
-      any_channel = any_channel || c.alarm;
     }
-    if (testing) update_hysteresis(loop, loop.lr_joint, lr_joint_raise_, lr_joint_clear_, loop.joint_alarm);
-    if (loop.diverging) loop.joint_alarm = false;
-    loop.alarm = loop.joint_alarm || any_channel;
-    // Paper Sec. 3.3: with the loop raised but no input standing out on its
-    // own, among the channels whose AR part matches N^-1 (gamma < lambda^2)
-    // the one with the largest pairwise F carries the mismatch.
-    std::size_t best = n_inputs_;
-    const double limit = settings_.gamma_lambda * settings_.gamma_lambda;
-    for (std::size_t i = 0; i < n_inputs_; ++i) {
-      ChannelStats& c = channels_[j * n_inputs_ + i];
-      c.located_by_gamma = false;
-      if (loop.alarm && !any_channel && c.gamma < limit &&
-          (best == n_inputs_ || c.f_pairwise > channels_[j * n_inputs_ + best].f_pairwise))
-        best = i;
-    }
-    if (best < n_inputs_) channels_[j * n_inputs_ + best].located_by_gamma = true;
+    update_detector(j);
+  }
+  refresh_long_windows();
+}
+
+void GrangerMonitor::refresh_long_windows() noexcept {
+  const std::size_t kw = detector_.windows();
+  if (kw < 2 || ++refresh_tick_ < kRefreshEvery) return;
+  refresh_tick_ = 0;
+  const std::size_t pairs = n_outputs_ * (kw - 1);
+  const std::size_t c = refresh_cursor_;
+  refresh_cursor_ = (refresh_cursor_ + 1) % pairs;
+  const std::size_t j = c / (kw - 1), k = 1 + c % (kw - 1);
+  if (j < first_output_ || j >= end_output_ || output_used_[j] <= burn_in_) return;
+  const NestedRls& reg = regressions_[j];
+  const std::size_t d = n_inputs_ * nb_;
+  if (reg.covariance_form()) {  // S = P^-1
+    reg.inputs_covariance(locate_cov_.data(), d);
+    info_llt_.compute(locate_cov_);
+    info_scratch_.setIdentity();
+    info_llt_.solveInPlace(info_scratch_);
+  } else {
+    reg.inputs_information(info_scratch_.data(), d);
+  }
+  info_scratch_ /= output_sum_w_[j];  // information per sample
+  std::uint64_t& last = refresh_last_[j * kw + k];
+  const double gap = static_cast<double>(output_used_[j] - last);
+  last = output_used_[j];
+  detector_.refresh_information(j, k, info_scratch_, gap);
+  std::uint32_t& count = refresh_count_[j * kw + k];
+  if (count < kMinRefreshes) ++count;
+  if (count < kMinRefreshes || !detector_.has_information(j, k) || loops_[j].diverging) return;
+  // T = s^T J^-1 s / sigma_W^2, both of the window's own memory.
+  const double var = detector_.variance(j, k);
+  const double t = detector_.normalised_quadratic(j, k) / var;
+  if (std::isfinite(t)) react(j, k, t, 1.0 / var);
+}
+
+void GrangerMonitor::update_detector(std::size_t j) noexcept {
+  NestedRls& reg = regressions_[j];
+  LoopStats& loop = loops_[j];
+  const double lambda = settings_.forgetting;
+  ++output_used_[j];
+  output_sum_w_[j] = lambda * output_sum_w_[j] + 1.0;
+  const double rss_ar = reg.rss_prefix_only();
+  if (!std::isfinite(rss_ar) || !std::isfinite(reg.rss_full())) {
+    reset_output(j);
+    return;
+  }
+  if (output_used_[j] < burn_in_) return;
+  // Score of the inputs' block against the AR-only model, this sample.
+  const std::size_t d = n_inputs_ * nb_;
+  const double* row = reg.apriori_row();
+  const double w = reg.apriori_weight();
+  detector_.accumulate(j, row, w * row[d], w * row[d] * row[d]);
+  if (loop.diverging) {  // no verdict on a diverging loop
+    loop.alarm = false;
+    return;
+  }
+  // The first window every sample (rho^2 = lambda: S is the score's own
+  // variance); the long ones when refresh_long_windows() renews them.
+  if ((output_used_[j] + j) % kFirstWindowEvery != 0) return;
+  const double n = output_sum_w_[j];
+  const double scale = detector_.variance_factor(0) * n * n / rss_ar;
+  const double t = scale * reg.information_quadratic(detector_.sum(j, 0), score_scratch_.data());
+  if (!std::isfinite(t)) {
+    reset_output(j);
+    return;
+  }
+  react(j, 0, t, scale);
+}
+
+void GrangerMonitor::react(std::size_t j, std::size_t k, double t, double scale) noexcept {
+  LoopStats& loop = loops_[j];
+  switch (detector_.test(j, k, t)) {
+    case DetectorEvent::kRaised:
+      ++counters_.raises;
+      loop.alarm = true;
+      loop.score = t;
+      loop.score_threshold = detector_.threshold(k);
+      loop.score_window = detector_.window(k);
+      locate(j, k, scale);
+      break;
+    case DetectorEvent::kCleared:
+      loop.alarm = false;
+      for (std::size_t i = 0; i < n_inputs_; ++i) {
+        channels_[j * n_inputs_ + i].alarm = false;
+        channels_[j * n_inputs_ + i].located_by_gamma = false;
+      }
+      break;
+    case DetectorEvent::kNone:
+      break;
   }
 }
 
-template <typename Stats>
-void GrangerMonitor::update_hysteresis(Stats& s, double lr, double raise, double clear, bool& alarm) noexcept {
-  if (lr > raise) {
-    ++s.above;
-    s.below = 0;
-  } else if (lr < clear) {
-    ++s.below;
-    s.above = 0;
-  } else {  // in the hysteresis band: neither counter advances
-    s.above = 0;
-    s.below = 0;
+void GrangerMonitor::locate(std::size_t j, std::size_t window, double scale) noexcept {
+  // The conditional score of block i given the others: with P = S^-1 and
+  // v = P s, s^T S^-1 s - s_-i^T S_-i^-1 s_-i = v_i^T [P]_ii^-1 v_i (Schur).
+  // O((m nb)^3), on a raise only; everything preallocated.
+  const std::size_t d = n_inputs_ * nb_;
+  const auto dd = static_cast<Eigen::Index>(d);
+  const auto nb = static_cast<Eigen::Index>(nb_);
+  // The window's own variance: S^-1 for the first window, J_W^-1 for the
+  // others (`scale` turns s^T cov s into its T).
+  if (window == 0) regressions_[j].inputs_covariance(locate_cov_.data(), d);
+  else detector_.information_inverse(j, window, locate_cov_);
+  const Eigen::Map<const Eigen::VectorXd> s(detector_.sum(j, window), dd);
+  locate_v_.noalias() = locate_cov_ * s;
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < n_inputs_; ++i) {
+    const auto b0 = static_cast<Eigen::Index>(i) * nb;
+    locate_block_ = locate_cov_.block(b0, b0, nb, nb);
+    locate_llt_.compute(locate_block_);
+    locate_x_ = locate_v_.segment(b0, nb);
+    locate_llt_.solveInPlace(locate_x_);
+    ChannelStats& c = channels_[j * n_inputs_ + i];
+    c.score_conditional = scale * locate_v_.segment(b0, nb).dot(locate_x_);
+    if (!std::isfinite(c.score_conditional)) c.score_conditional = 0.0;
+    c.alarm = false;
+    c.located_by_gamma = false;
+    if (c.score_conditional > channels_[j * n_inputs_ + best].score_conditional) best = i;
   }
-  if (!alarm && s.above >= settings_.raise_after) alarm = true;
-  if (alarm && s.below >= settings_.clear_after) alarm = false;
+  // No input stands out on its own (collinear inputs): the paper's rule,
+  // among the channels whose AR part matches N^-1 the largest pairwise F.
+  if (channels_[j * n_inputs_ + best].score_conditional < score_raise_) {
+    const double limit = settings_.gamma_lambda * settings_.gamma_lambda;
+    std::size_t by_gamma = n_inputs_;
+    for (std::size_t i = 0; i < n_inputs_; ++i) {
+      const ChannelStats& c = channels_[j * n_inputs_ + i];
+      if (c.gamma < limit && (by_gamma == n_inputs_ || c.f_pairwise > channels_[j * n_inputs_ + by_gamma].f_pairwise))
+        by_gamma = i;
+    }
+    if (by_gamma < n_inputs_) {
+      channels_[j * n_inputs_ + by_gamma].alarm = true;
+      channels_[j * n_inputs_ + by_gamma].located_by_gamma = true;
+      return;
+    }
+  }
+  channels_[j * n_inputs_ + best].alarm = true;
 }
 
 void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
@@ -369,6 +612,16 @@ void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
       channels_[c] = part.channels_[c];
     }
     loops_[j] = part.loops_[j];
+    output_used_[j] = part.output_used_[j];
+    output_sum_w_[j] = part.output_sum_w_[j];
+    last_good_[j] = part.last_good_[j];
+    jump_scale_[j] = part.jump_scale_[j];
+    outlier_run_[j] = part.outlier_run_[j];
+    detector_.adopt_output(part.detector_, j);
+    for (std::size_t k = 0; k < detector_.windows(); ++k) {
+      refresh_last_[j * detector_.windows() + k] = part.refresh_last_[j * detector_.windows() + k];
+      refresh_count_[j * detector_.windows() + k] = part.refresh_count_[j * detector_.windows() + k];
+    }
     mean_fast_[jj] = part.mean_fast_[jj];
     var_fast_[jj] = part.var_fast_[jj];
     var_baseline_[jj] = part.var_baseline_[jj];
@@ -382,6 +635,8 @@ void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
   sum_w_ = part.sum_w_;
   sum_w2_ = part.sum_w2_;
   n_eq_ = part.n_eq_;
+  refresh_tick_ = part.refresh_tick_;
+  refresh_cursor_ = part.refresh_cursor_;
 }
 
 void GrangerMonitor::full_coefficients(std::size_t output, Eigen::Ref<Eigen::VectorXd> out) const noexcept {

@@ -40,9 +40,18 @@
 // apart. Then the paper's two indices name the channel (located_by_gamma):
 // of the channels whose AR part matches N^-1, the one with the largest F.
 //
-// Alarms: a channel is raised when its conditional LR exceeds the threshold
-// for `raise_after` consecutive samples, cleared when it stays below the
-// clear threshold (a lower, hysteresis level) for `clear_after` samples.
+// Alarms: a sequential detector per output (sequential_detector.hpp): the
+// score test of all inputs against the AR-only model, accumulated over
+// several memories at once, with thresholds derived from a stated false-
+// alarm rate per unit time for the whole controller. When an output is
+// raised, the channel is named by the best evidence: the conditional score
+// of each input given the others (from the raising window's score), or, if
+// none stands out on its own, the paper's gamma rule.
+//
+// Robustness: a sample whose residual jumps by more than `outlier_limit`
+// robust standard deviations of its recent one-step changes is skipped and
+// counted (the residual lags hold the previous value); an output whose
+// statistics go non-finite starts again from its prior, counted.
 #pragma once
 
 #include <cstddef>
@@ -54,6 +63,7 @@
 #include <Eigen/Dense>
 
 #include "core/nested_rls.hpp"
+#include "core/sequential_detector.hpp"
 #include "core/transfer_function.hpp"
 
 namespace mpm {
@@ -66,11 +76,14 @@ struct MonitorSettings {
                                  // paper; near the process's dominant pole, nb
                                  // functions span a memory of ~nb/(1-a) samples
   double forgetting = 0.999;     // lambda in (0, 1]; 1 = growing window
-  double false_alarm = 1e-3;     // per-channel, per-test probability alpha of
-                                 // exceeding the raise threshold under H0
-  double clear_ratio = 0.5;      // clear threshold = clear_ratio * raise threshold
-  int raise_after = 20;          // consecutive samples above to raise
-  int clear_after = 100;         // consecutive samples below to clear
+  double false_alarm = 1e-3;     // probability alpha of the end-of-record test
+                                 // (record_verdict) per channel and test, and the
+                                 // level at which a raise's conditional score
+                                 // names a channel on its own
+  DetectorSettings detector;     // live alarms: stated rate per unit time
+  double outlier_limit = 10.0;   // skip a sample whose residual moves more than
+                                 // this many robust standard deviations of its
+                                 // recent one-step changes (0 = never)
   int warmup = 0;                // samples before any test (0 = automatic:
                                  // 10 x number of regressors)
   double gamma_lambda = 0.1;     // paper's lambda: gamma < lambda^2 locates
@@ -84,6 +97,7 @@ enum class SampleStatus : std::uint8_t {
   kUsed,        // entered the statistics
   kMissing,     // a NaN/inf in u or residual: skipped, lags restart after it
   kWarmingUp,   // filled lags only (after start or a gap)
+  kOutlier,     // a residual beyond the robust bound: skipped, counted
 };
 
 struct ChannelStats {
@@ -92,24 +106,24 @@ struct ChannelStats {
   double lr_pairwise = 0.0;    // n_eq * f_pairwise
   double lr_conditional = 0.0; // n_eq * f_conditional
   double gamma = 0.0;          // noise-model index (NaN when N is unknown)
-  bool alarm = false;          // raised by its own conditional test
-  bool located_by_gamma = false;  // the loop is raised, no input passes its
-                               // own test, this channel's gamma < lambda^2 and
-                               // its pairwise F is the largest of those: the
-                               // paper's locating rule
-  int above = 0;               // consecutive samples above the raise level
-  int below = 0;               // consecutive samples below the clear level
+  double score_conditional = 0.0;  // at the output's last raise: the
+                               // conditional score statistic of this input
+                               // given the others (chi-square, nb dof)
+  bool alarm = false;          // the channel named in a raised output
+  bool located_by_gamma = false;  // named by the paper's rule (gamma < lambda^2,
+                               // largest pairwise F) because no input's
+                               // conditional score stood out on its own
 };
 
 struct LoopStats {
   double lr_joint = 0.0;         // all inputs together vs AR only, m*nb dof
-  bool joint_alarm = false;      // the joint test's own alarm state
-  int above = 0;                 // hysteresis counters of the joint test
-  int below = 0;
+  double score = 0.0;            // at the last raise: T_W of the raising window
+  double score_threshold = 0.0;  // its threshold h_W
+  double score_window = 0.0;     // its memory W (samples)
   double sigma1 = 0.0;           // AR-only residual variance (weighted)
   double sigma_full = 0.0;       // full-model residual variance (weighted)
   double residual_variance = 0.0;// weighted variance of d~ about its mean
-  bool alarm = false;            // joint test raised, or any channel raised
+  bool alarm = false;            // raised by the sequential detector
   bool diverging = false;        // residual variance growing without bound
 };
 
@@ -118,6 +132,9 @@ struct MonitorCounters {
   std::uint64_t used = 0;        // samples that entered the statistics
   std::uint64_t missing = 0;     // samples with NaN/inf skipped
   std::uint64_t gaps = 0;        // runs of missing samples
+  std::uint64_t outliers = 0;    // samples skipped beyond the robust bound
+  std::uint64_t resets = 0;      // outputs restarted after non-finite statistics
+  std::uint64_t raises = 0;      // raise events of the sequential detector
 };
 
 // The outputs a monitor models: [first, first + count), clipped to the
@@ -161,11 +178,13 @@ class GrangerMonitor {
 
   // Equivalent sample count behind the current statistics.
   double effective_samples() const noexcept { return n_eq_; }
+  // End-of-record test thresholds (chi-square quantiles at false_alarm).
   double raise_threshold() const noexcept { return lr_raise_; }
   double joint_raise_threshold() const noexcept { return lr_joint_raise_; }
   // p-value of a loop's joint LR (chi-square, n_inputs * nb dof).
   double joint_p_value(double lr) const noexcept;
-  double clear_threshold() const noexcept { return lr_clear_; }
+  // The live detector (thresholds, windows, last statistics).
+  const SequentialDetector& detector() const noexcept { return detector_; }
   bool ready() const noexcept;  // warm-up over
 
   // p-value of an LR statistic under H0 (chi-square, nb dof). Not for the hot
@@ -187,6 +206,41 @@ class GrangerMonitor {
   // Forgets everything learnt: statistics, lags, alarms (counters are kept).
   void reset() noexcept;
 
+  // Every member that changes after setup (for checkpointing).
+  template <class V>
+  void visit_state(V&& v) {
+    for (NestedRls& r : regressions_) r.visit_state(v);
+    v(residual_lags_);
+    v(input_lags_);
+    v(lags_filled_);
+    v(input_ref_);
+    v(counters_.samples);
+    v(counters_.used);
+    v(counters_.missing);
+    v(counters_.gaps);
+    v(counters_.outliers);
+    v(counters_.resets);
+    v(counters_.raises);
+    v(in_gap_);
+    v(used_since_reset_);
+    v(sum_w_);
+    v(sum_w2_);
+    v(n_eq_);
+    v(mean_fast_);
+    v(var_fast_);
+    v(var_baseline_);
+    v(output_used_);
+    v(output_sum_w_);
+    v(last_good_);
+    v(jump_scale_);
+    v(outlier_run_);
+    v(refresh_last_);
+    v(refresh_count_);
+    v(refresh_tick_);
+    v(refresh_cursor_);
+    detector_.visit_state(v);
+  }
+
   // The outputs this monitor models (all unless constructed with a range);
   // statistics of the others stay at their initial values.
   std::size_t first_modelled_output() const noexcept { return first_output_; }
@@ -200,9 +254,16 @@ class GrangerMonitor {
   void absorb_sample(const double* residual) noexcept;
   void push_lags(const double* u, const double* residual) noexcept;
   void update_statistics() noexcept;
-  template <typename Stats>
-  void update_hysteresis(Stats& s, double lr, double raise, double clear, bool& alarm) noexcept;
   void update_divergence(const double* residual) noexcept;
+  // True when the sample is an outlier (then `clean_` holds the residual
+  // with the outlying outputs at their last good value).
+  bool screen_outliers(const double* residual) noexcept;
+  void update_detector(std::size_t j) noexcept;
+  void locate(std::size_t j, std::size_t window, double scale) noexcept;
+  void reset_output(std::size_t j) noexcept;
+  void refresh_long_windows() noexcept;
+  // A statistic T of window k of output j: raise or clear, and locate.
+  void react(std::size_t j, std::size_t k, double t, double scale) noexcept;
 
   MonitorSettings settings_;
   std::size_t n_inputs_;
@@ -248,9 +309,34 @@ class GrangerMonitor {
   double sum_w2_ = 0.0;  // sum of squared weights
   double n_eq_ = 0.0;
   double lr_raise_ = 0.0;
-  double lr_clear_ = 0.0;
   double lr_joint_raise_ = 0.0;
-  double lr_joint_clear_ = 0.0;
+  double score_raise_ = 0.0;       // conditional score level naming a channel alone
+  // Sequential detector and its per-output bookkeeping.
+  SequentialDetector detector_;
+  std::vector<std::uint64_t> output_used_;  // samples used since the output's (re)start
+  std::uint64_t burn_in_ = 0;               // used samples before the score starts
+  std::vector<double> output_sum_w_;         // its sum of forgetting weights
+  Eigen::VectorXd score_scratch_;            // m nb
+  Eigen::MatrixXd locate_cov_;               // m nb x m nb, for a raise
+  Eigen::VectorXd locate_v_;                 // m nb
+  Eigen::MatrixXd locate_block_;             // nb x nb
+  Eigen::VectorXd locate_x_;                 // nb
+  Eigen::LLT<Eigen::MatrixXd> locate_llt_;
+  // Long windows' information refresh: one (output, window) every few
+  // samples, round robin over every output (modelled or not, so a part of
+  // the outputs refreshes exactly as the whole monitor does).
+  Eigen::MatrixXd info_scratch_;               // m nb x m nb
+  Eigen::LLT<Eigen::MatrixXd> info_llt_;       // m nb (covariance form: S = P^-1)
+  std::vector<std::uint64_t> refresh_last_;    // output_used_ at each pair's last refresh
+  std::vector<std::uint32_t> refresh_count_;   // refreshes since the output's (re)start
+  std::uint64_t refresh_tick_ = 0;
+  std::size_t refresh_cursor_ = 0;
+  // Outlier screening per output: last good residual, mean absolute one-step
+  // change (clipped), consecutive rejections; and the cleaned sample.
+  std::vector<double> last_good_;
+  std::vector<double> jump_scale_;
+  std::vector<int> outlier_run_;
+  std::vector<double> clean_;
   // Divergence detection per output: running mean and variance of d~ with a
   // short memory, and the quietest variance seen (the baseline).
   Eigen::VectorXd mean_fast_;

@@ -44,6 +44,7 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
   else lower_ = UdRls(m_ * nb_, forgetting, regularization);
   pairs_.assign(wald_ ? m_ : m_ - 1, UdRls(nb_, forgetting, regularization));
   row_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(givens::padded(cols_)));
+  apriori_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m_ * nb_ + 1));
   pair_rhs_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(m_));
   coef_b_.resize(static_cast<Eigen::Index>(m_ * nb_));
   pair_beta_b_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(givens::padded(nb_)), static_cast<Eigen::Index>(m_));
@@ -60,6 +61,8 @@ void NestedRls::reset() noexcept {
   for (UdRls& p : pairs_) p.reset();
   since_prior_ = 0;
   next_prior_row_ = 0;
+  apriori_.setZero();
+  apriori_weight_ = 0.0;
 }
 
 void NestedRls::absorb_top(std::size_t first, double lambda) noexcept {
@@ -139,6 +142,8 @@ void NestedRls::update_staged(NestedRls* models, std::size_t count) noexcept {
   };
   for (std::size_t k = 0; k < count; ++k) {
     NestedRls& n = models[k];
+    std::copy(n.row_.data() + n.a_, n.row_.data() + n.cols_, n.apriori_.data());
+    n.apriori_weight_ = n.row_weight_;
     n.stage_lowers();
     if (n.wald_) n.lower_wald_.update_staged();
     else add(n.lower_);
@@ -297,6 +302,77 @@ void NestedRls::solve_full(Eigen::Ref<Eigen::VectorXd> out) const noexcept {
   else lower_.solve_prefix(m_ * nb_, coef_b_);
   solve_top(0, m_ * nb_, coef_b_.data(), out.data());
   std::copy(coef_b_.data(), coef_b_.data() + m_ * nb_, out.data() + a_);
+}
+
+double NestedRls::information_quadratic(const double* s, double* z) const noexcept {
+  const std::size_t d = m_ * nb_;
+  if (wald_) return lower_wald_.covariance_quadratic(s);
+  // S = U^T D U over the first d regressors: z = U^-T s by forward
+  // substitution (rows of U are contiguous), then sum z_i^2 / D_i.
+  const auto u = lower_.unit_factor();
+  const double* base = u.data();
+  const auto ld = static_cast<std::size_t>(u.outerStride());
+  const Eigen::VectorXd& dd = lower_.weights();
+  std::copy(s, s + d, z);
+  double q = 0.0;
+  for (std::size_t i = 0; i < d; ++i) {
+    const double zi = z[i];
+    const double* row = base + i * ld;
+    for (std::size_t k = i + 1; k < d; ++k) z[k] -= row[k] * zi;
+    q += zi * zi / dd[static_cast<Eigen::Index>(i)];
+  }
+  return q;
+}
+
+void NestedRls::inputs_covariance(double* out, std::size_t ld) const noexcept {
+  const std::size_t d = m_ * nb_;
+  if (wald_) {
+    lower_wald_.covariance_into(out, ld);
+    return;
+  }
+  // P = U^-1 D^-1 U^-T: V = U^-1 column by column into the upper triangle of
+  // out (back substitution), then P_ab = sum_j V_aj V_bj / D_j.
+  const auto u = lower_.unit_factor();
+  const double* base = u.data();
+  const auto lu = static_cast<std::size_t>(u.outerStride());
+  const Eigen::VectorXd& dd = lower_.weights();
+  const auto v = [&](std::size_t a, std::size_t j) -> double& { return out[a + j * ld]; };
+  for (std::size_t j = 0; j < d; ++j) {
+    v(j, j) = 1.0;
+    for (std::size_t a = j; a-- > 0;) {
+      double x = 0.0;
+      for (std::size_t k = a + 1; k <= j; ++k) x -= base[a * lu + k] * v(k, j);
+      v(a, j) = x;
+    }
+  }
+  // P into the lower triangle, column b after column b: P_ab (a <= b) reads
+  // V_aj and V_bj for j >= b only, none of which the lower triangle's
+  // earlier entries (or this diagonal, read before written) overwrote.
+  for (std::size_t b = 0; b < d; ++b)
+    for (std::size_t a = 0; a <= b; ++a) {
+      double x = 0.0;
+      for (std::size_t j = b; j < d; ++j) x += v(a, j) * v(b, j) / dd[static_cast<Eigen::Index>(j)];
+      out[b + a * ld] = x;  // lower triangle (row b, column a)
+    }
+  for (std::size_t b = 0; b < d; ++b)
+    for (std::size_t a = 0; a < b; ++a) out[a + b * ld] = out[b + a * ld];
+}
+
+void NestedRls::inputs_information(double* out, std::size_t ld) const noexcept {
+  // S = U^T D U over the inputs' block (U unit upper): row i of D U is D_i
+  // times row i of U, so S = sum_i D_i u_i^T u_i, one rank-one update per row
+  // on the upper triangle (row i of U is zero before column i), mirrored.
+  const auto d = static_cast<Eigen::Index>(m_ * nb_);
+  const auto u = lower_.unit_factor();
+  const Eigen::VectorXd& dd = lower_.weights();
+  Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> s(out, d, d, Eigen::OuterStride<>(static_cast<Eigen::Index>(ld)));
+  s.setZero();
+  for (Eigen::Index i = 0; i < d; ++i) {
+    const auto row = u.row(i).segment(i, d - i);
+    for (Eigen::Index b = i; b < d; ++b) s.col(b).segment(i, b - i + 1).noalias() += (dd[i] * row[b - i]) * row.head(b - i + 1).transpose();
+  }
+  for (Eigen::Index b = 0; b < d; ++b)
+    for (Eigen::Index a = b + 1; a < d; ++a) s(a, b) = s(b, a);
 }
 
 }  // namespace mpm

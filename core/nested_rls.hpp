@@ -96,8 +96,41 @@ class NestedRls {
   // All coefficients of the full model (n_regressors() values). Real-time safe.
   void solve_full(Eigen::Ref<Eigen::VectorXd> out) const noexcept;
 
+  // What the last update's sample was before it was absorbed, as the
+  // trapezoid of [1, AR] left it: m nb values x~ (the input regressors'
+  // a-priori residuals given A) then e (the a-priori AR-only prediction
+  // error), all with weight apriori_weight() (the conversion factor). The
+  // sequential detector's score is apriori_weight() * e * x~. Real-time safe.
+  const double* apriori_row() const noexcept { return apriori_.data(); }
+  double apriori_weight() const noexcept { return apriori_weight_; }
+  // s^T S^-1 s for S the information of the inputs' block given A (the
+  // lower factor's [B] block: U^T D U, or P^-1 in covariance form). `scratch`:
+  // at least m nb values. Real-time safe; one triangular solve.
+  double information_quadratic(const double* s, double* scratch) const noexcept;
+  // S itself (information form only: !wald_tests), m nb x m nb column major.
+  // O((m nb)^3) real-time safe: for a periodic refresh.
+  void inputs_information(double* out, std::size_t ld) const noexcept;
+  bool covariance_form() const noexcept { return wald_; }
+  // S^-1 (m nb x m nb, column major, leading dimension ld). O((m nb)^3),
+  // real-time safe: for a raise, not for every sample.
+  void inputs_covariance(double* out, std::size_t ld) const noexcept;
+
   // Back to the prior.
   void reset() noexcept;
+
+  // Every member that changes after setup (for checkpointing).
+  template <class V>
+  void visit_state(V&& v) {
+    v(since_prior_);
+    v(next_prior_row_);
+    v(top_);
+    v(top_d_);
+    if (wald_) lower_wald_.visit_state(v);
+    else lower_.visit_state(v);
+    for (UdRls& p : pairs_) p.visit_state(v);
+    v(apriori_);
+    v(apriori_weight_);
+  }
 
  private:
   std::size_t a_ = 0;
@@ -119,6 +152,8 @@ class NestedRls {
   std::vector<UdRls> pairs_;      // [B_i | y] given A, i = 2..m (i = 1..m with wald_)
   Eigen::VectorXd row_;           // staged row, cols values
   double row_weight_ = 1.0;       // its weight after the trapezoid's rotations
+  Eigen::VectorXd apriori_;       // the last sample's row as the trapezoid left it (m nb + 1)
+  double apriori_weight_ = 0.0;
   mutable Eigen::VectorXd coef_b_;  // scratch: B coefficients (m nb)
   mutable Eigen::MatrixXd pair_beta_b_;  // padded(nb) x m: beta_B_i, zero padded
   mutable Eigen::MatrixXd pair_rhs_;     // a x m: U_Ay - U_AB_i beta_B_i

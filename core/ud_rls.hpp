@@ -68,6 +68,18 @@ class UdRls {
   const Eigen::VectorXd& weights() const noexcept { return d_; }
   void reset() noexcept;
 
+  // Every member that changes after setup (for checkpointing).
+  template <class V>
+  void visit_state(V&& v) {
+    v(since_prior_);
+    v(next_prior_row_);
+    v(u_);
+    v(d_);
+    v(changes_);
+    v(rss_stamp_);
+    v(rss_tail_);
+  }
+
  private:
   std::size_t p_ = 0;
   double lambda_ = 1.0;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "config/plant_loader.hpp"
+#include "core/chi_square.hpp"
 #include "core/granger_monitor.hpp"
 #include "core/mimo_model.hpp"
 #include "daemon/args.hpp"
@@ -32,7 +33,22 @@ constexpr const char* kUsage =
     "                     input filtered through the nominal channel G_ji, where it is nonzero)\n"
     "  --threads N        threads, each replaying a part of the outputs (default: one per\n"
     "                     core, at most one per output; the result does not depend on it)\n"
-    "  --json             print one JSON object instead of the table\n";
+    "  --json             print one JSON object instead of the table\n"
+    "  --events           print the live detector's raise and clear events as JSON lines\n"
+    "                     (one thread; use --forgetting 0.999 for mpmd's default memory)\n"
+    "  --false-alarms-per-year R  stated false-alarm rate of the live detector for the\n"
+    "                     whole controller (default 1; the sample time is the plant's)\n"
+    "  --crossing-constant C  the detector's crossing-rate constant (from mpm calibrate)\n"
+    "The loop verdict is the end-of-record test (the statistics after the last sample);\n"
+    "'first raised' is the live detector's first raise.\n";
+
+// A JSON number, or null when not finite (JSON has no NaN or infinity).
+std::string num(double v) {
+  if (!std::isfinite(v)) return "null";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
 
 struct ChannelTrace {
   long raised_at = -1;  // first sample the alarm was raised
@@ -42,6 +58,7 @@ struct ChannelTrace {
 
 void print_table(const PlantModel& plant, const GrangerMonitor& m, const std::vector<ChannelTrace>& trace,
                  std::size_t samples, std::size_t transient) {
+  const RecordVerdict verdict = record_verdict(m);
   const auto& s = m.settings();
   std::printf("plant %s: %zu samples (first %zu skipped: model start-up transient)\n", plant.name.c_str(), samples,
               transient);
@@ -51,14 +68,16 @@ void print_table(const PlantModel& plant, const GrangerMonitor& m, const std::ve
   for (std::size_t j = 0; j < m.n_outputs(); ++j) {
     const LoopStats& l = m.loop(j);
     std::printf("\noutput %s: %s   joint p %.3g, residual variance %.4g, AR-only Sigma1 %.4g, full model %.4g\n",
-                plant.outputs[j].c_str(), l.diverging ? "DIVERGING (not analysed)" : l.alarm ? "MISMATCH" : "ok",
+                plant.outputs[j].c_str(), l.diverging ? "DIVERGING (not analysed)" : verdict.loop_mismatch[j] ? "MISMATCH" : "ok",
                 m.joint_p_value(l.lr_joint), l.residual_variance, l.sigma1, l.sigma_full);
     std::printf("  %-10s %12s %12s %12s %10s  %s\n", "input", "F pairwise", "F cond.", "p (cond.)", "gamma", "alarm");
     for (std::size_t i = 0; i < m.n_inputs(); ++i) {
       const ChannelStats& c = m.channel(j, i);
       const ChannelTrace& t = trace[j * m.n_inputs() + i];
+      bool located = false, by_gamma = verdict.by_gamma[j * m.n_inputs() + i];
+      for (const auto& [oj, oi] : verdict.located) located = located || (oj == j && oi == i);
       std::printf("  %-10s %12.4g %12.4g %12.3g %10.4g  %s", plant.inputs[i].c_str(), c.f_pairwise, c.f_conditional,
-                  m.p_value(c.lr_conditional), c.gamma, c.alarm ? "RAISED" : c.located_by_gamma ? "located by gamma" : "-");
+                  m.p_value(c.lr_conditional), c.gamma, by_gamma ? "located by gamma" : located ? "MISMATCH" : "-");
       if (t.raised_at >= 0) std::printf(" (first raised at sample %ld)", t.raised_at);
       std::printf("\n");
     }
@@ -67,31 +86,60 @@ void print_table(const PlantModel& plant, const GrangerMonitor& m, const std::ve
 
 void print_json(const PlantModel& plant, const GrangerMonitor& m, const std::vector<ChannelTrace>& trace,
                 std::size_t samples) {
-  std::printf("{\"plant\": \"%s\", \"samples\": %zu, \"lr_threshold\": %.6g, \"loops\": [", plant.name.c_str(), samples,
-              m.raise_threshold());
+  const RecordVerdict verdict = record_verdict(m);
+  std::printf("{\"plant\": \"%s\", \"samples\": %zu, \"lr_threshold\": %s, \"loops\": [", plant.name.c_str(), samples,
+              num(m.raise_threshold()).c_str());
   for (std::size_t j = 0; j < m.n_outputs(); ++j) {
     const LoopStats& l = m.loop(j);
-    std::printf("%s{\"output\": \"%s\", \"alarm\": %s, \"diverging\": %s, \"residual_variance\": %.6g, "
-                "\"sigma1\": %.6g, \"channels\": [",
-                j ? ", " : "", plant.outputs[j].c_str(), l.alarm ? "true" : "false", l.diverging ? "true" : "false",
-                l.residual_variance, l.sigma1);
+    std::printf("%s{\"output\": \"%s\", \"alarm\": %s, \"mismatch\": %s, \"diverging\": %s, "
+                "\"residual_variance\": %s, \"sigma1\": %s, \"joint_p_value\": %s, \"channels\": [",
+                j ? ", " : "", plant.outputs[j].c_str(), l.alarm ? "true" : "false",
+                verdict.loop_mismatch[j] ? "true" : "false", l.diverging ? "true" : "false",
+                num(l.residual_variance).c_str(), num(l.sigma1).c_str(), num(m.joint_p_value(l.lr_joint)).c_str());
     for (std::size_t i = 0; i < m.n_inputs(); ++i) {
       const ChannelStats& c = m.channel(j, i);
-      std::printf("%s{\"input\": \"%s\", \"F\": %.6g, \"F_conditional\": %.6g, \"p_value\": %.6g, \"gamma\": %s, "
+      std::printf("%s{\"input\": \"%s\", \"F\": %s, \"F_conditional\": %s, \"p_value\": %s, \"gamma\": %s, "
                   "\"alarm\": %s, \"located_by_gamma\": %s, \"raised_at\": %ld}",
-                  i ? ", " : "", plant.inputs[i].c_str(), c.f_pairwise, c.f_conditional, m.p_value(c.lr_conditional),
-                  std::isfinite(c.gamma) ? std::to_string(c.gamma).c_str() : "null", c.alarm ? "true" : "false", c.located_by_gamma ? "true" : "false",
-                  trace[j * m.n_inputs() + i].raised_at);
+                  i ? ", " : "", plant.inputs[i].c_str(), num(c.f_pairwise).c_str(), num(c.f_conditional).c_str(),
+                  num(m.p_value(c.lr_conditional)).c_str(), num(c.gamma).c_str(), c.alarm ? "true" : "false",
+                  c.located_by_gamma ? "true" : "false", trace[j * m.n_inputs() + i].raised_at);
     }
     std::printf("]}");
   }
-  std::printf("]}\n");
+  const MonitorCounters& k = m.counters();
+  std::printf("], \"counters\": {\"used\": %llu, \"missing\": %llu, \"outliers\": %llu, \"resets\": %llu, "
+              "\"raises\": %llu}}\n",
+              static_cast<unsigned long long>(k.used), static_cast<unsigned long long>(k.missing),
+              static_cast<unsigned long long>(k.outliers), static_cast<unsigned long long>(k.resets),
+              static_cast<unsigned long long>(k.raises));
+}
+
+// One JSON line per change of an output's raised state.
+void print_event(const PlantModel& plant, const GrangerMonitor& m, std::size_t k, std::size_t j) {
+  const LoopStats& l = m.loop(j);
+  std::string channel = "null", score = "null", p = "null";
+  bool by_gamma = false;
+  for (std::size_t i = 0; i < m.n_inputs(); ++i)
+    if (m.channel(j, i).alarm) {
+      channel = "\"" + plant.inputs[i] + "\"";
+      score = num(m.channel(j, i).score_conditional);
+      p = num(chi_square_survival(m.channel(j, i).score_conditional, static_cast<double>(m.settings().input_order)));
+      by_gamma = m.channel(j, i).located_by_gamma;
+    }
+  std::printf("{\"event\": \"%s\", \"sample\": %zu, \"output\": \"%s\", \"channel\": %s, \"statistic\": %s, "
+              "\"threshold\": %s, \"window\": %s, \"p_value\": %s, \"conditional_score\": %s, \"by_gamma\": %s, "
+              "\"physics\": null}\n",
+              l.alarm ? "raised" : "cleared", k, plant.outputs[j].c_str(), channel.c_str(), num(l.score).c_str(),
+              num(l.score_threshold).c_str(), num(l.score_window).c_str(),
+              num(chi_square_survival(l.score, static_cast<double>(m.n_inputs() * static_cast<std::size_t>(m.settings().input_order)))).c_str(),
+              score.c_str(), by_gamma ? "true" : "false");
 }
 
 int run(int argc, char** argv) {
   try {
-    const Args args(argc, argv, {"plant", "data", "ar-order", "input-order", "input-pole", "forgetting", "false-alarm", "threads"},
-                    {"json", "plain-lags", "help"});
+    const Args args(argc, argv, {"plant", "data", "ar-order", "input-order", "input-pole", "forgetting", "false-alarm", "threads",
+                     "false-alarms-per-year", "crossing-constant"},
+                    {"json", "events", "plain-lags", "help"});
     if (args.flag("help")) {
       std::fputs(kUsage, stdout);
       return 0;
@@ -101,6 +149,9 @@ int run(int argc, char** argv) {
     settings.input_order = args.integer("input-order", settings.input_order);
     settings.forgetting = args.number("forgetting", 1.0);
     settings.false_alarm = args.number("false-alarm", settings.false_alarm);
+    settings.detector.false_alarms_per_year =
+        args.number("false-alarms-per-year", settings.detector.false_alarms_per_year);
+    settings.detector.crossing_constant = args.number("crossing-constant", settings.detector.crossing_constant);
     const PlantModel plant = config::load_plant(args.required("plant"));
     const std::string pole = args.get("input-pole").value_or("0");
     settings.input_pole = pole == "auto" ? dominant_pole(plant) : args.number("input-pole", 0.0);
@@ -112,13 +163,20 @@ int run(int argc, char** argv) {
     const config::BoundRecording bound = config::bind(plant, rec);
     const ResidualSeries series = compute_residuals(plant, rec, bound);
 
-    const std::size_t threads =
-        requested_threads > 0 ? static_cast<std::size_t>(requested_threads) : replay_threads(plant.n_outputs());
+    const bool events = args.flag("events");
+    const std::size_t threads = events ? 1  // events in sample order
+                                : requested_threads > 0 ? static_cast<std::size_t>(requested_threads)
+                                                        : replay_threads(plant.n_outputs());
     std::vector<ChannelTrace> trace(plant.n_inputs() * plant.n_outputs());
+    std::vector<char> raised(plant.n_outputs(), 0);
     // On each part's thread: only its outputs, so the parts write disjoint traces.
     const GrangerMonitor monitor =
         monitor_record(plant, series, settings, threads, args.flag("plain-lags"), [&](std::size_t k, const GrangerMonitor& m) {
-      for (std::size_t j = m.first_modelled_output(); j < m.end_modelled_output(); ++j)
+      for (std::size_t j = m.first_modelled_output(); j < m.end_modelled_output(); ++j) {
+        if (m.loop(j).alarm != (raised[j] != 0)) {
+          raised[j] = m.loop(j).alarm ? 1 : 0;
+          if (events) print_event(plant, m, k, j);
+        }
         for (std::size_t i = 0; i < m.n_inputs(); ++i) {
           ChannelTrace& t = trace[j * m.n_inputs() + i];
           const bool now = m.channel(j, i).alarm;
@@ -126,8 +184,11 @@ int run(int argc, char** argv) {
           if (!now && t.was_alarm) t.cleared_at = static_cast<long>(k);
           t.was_alarm = now;
         }
+      }
     });
-    if (args.flag("json")) {
+    if (events) {
+      // the events were the output
+    } else if (args.flag("json")) {
       print_json(plant, monitor, trace, rec.samples());
     } else {
       print_table(plant, monitor, trace, rec.samples(), series.transient);

@@ -104,8 +104,13 @@ std::vector<double> reference_variances(const PlantModel& plant) {
   return out;
 }
 
+MonitorSettings for_plant(MonitorSettings settings, const PlantModel& plant) {
+  if (settings.detector.sample_time <= 0.0 && plant.sample_time > 0.0) settings.detector.sample_time = plant.sample_time;
+  return settings;
+}
+
 MonitorPartFactory monitor_factory(const PlantModel& plant, const MonitorSettings& settings, bool plain_lags) {
-  return [m = plant.n_inputs(), n = plant.n_outputs(), settings, noise = noise_ar(plant, settings.ar_order),
+  return [m = plant.n_inputs(), n = plant.n_outputs(), settings = for_plant(settings, plant), noise = noise_ar(plant, settings.ar_order),
           reference = reference_variances(plant),
           channels = plain_lags ? std::vector<std::optional<DiscreteTf>>{} : channel_models(plant)](OutputRange outputs) {
     return GrangerMonitor(m, n, settings, noise, reference, channels, outputs);

@@ -32,6 +32,10 @@ ResidualSeries compute_residuals(const PlantModel& plant, const config::Recordin
 // Noise-model AR coefficients (1 - N^-1) per output, for the gamma index.
 std::vector<std::optional<std::vector<double>>> noise_ar(const PlantModel& plant, int order);
 
+// The settings with what the plant file knows filled in: the detector's
+// sample time (0 in the settings = the plant's).
+MonitorSettings for_plant(MonitorSettings settings, const PlantModel& plant);
+
 // Variance of each output's residual with a matched model (N's output
 // variance), 0 where the plant file gives no noise model or no variance.
 std::vector<double> reference_variances(const PlantModel& plant);

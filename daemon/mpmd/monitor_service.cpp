@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "core/chi_square.hpp"
 #include "daemon/offline.hpp"
 #include "daemon/mpmd/log.hpp"
 
@@ -57,7 +58,7 @@ MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& s
       settings_(settings),
       on_alarm_(std::move(on_alarm)),
       // The same monitor as `mpm monitor` builds offline (daemon/offline.hpp).
-      monitor_(plant.n_inputs(), plant.n_outputs(), settings.monitor, noise_ar(plant, settings.monitor.ar_order),
+      monitor_(plant.n_inputs(), plant.n_outputs(), for_plant(settings.monitor, plant), noise_ar(plant, settings.monitor.ar_order),
                reference_variances(plant),
                settings.plain_lags ? std::vector<std::optional<DiscreteTf>>{} : channel_models(plant)),
       tracker_(settings.max_sequence_jump),
@@ -216,15 +217,19 @@ void MonitorService::publish_alarm(std::size_t output, std::size_t input, const 
   alarm_.gamma = c.gamma;
   alarm_.physics.clear();  // the online monitor locates; naming physics is the offline diagnosis' job
   char text[256];
+  const LoopStats& l = monitor_.loop(output);
   if (c.alarm) {
+    // The output's sequential detector raised; this channel has the best
+    // evidence (its conditional score, or the paper's gamma rule).
+    alarm_.p_value = chi_square_survival(c.score_conditional, static_cast<double>(monitor_.settings().input_order));
     std::snprintf(text, sizeof text,
-                  "model-plant mismatch on %s -> %s: F=%.4g, LR %.1f > %.1f (p=%.2g), gamma=%.3g",
-                  alarm_.input.c_str(), alarm_.output.c_str(), c.f_conditional, c.lr_conditional,
-                  monitor_.raise_threshold(), alarm_.p_value, c.gamma);
+                  "model-plant mismatch on %s -> %s: score %.1f > %.1f over %.0f samples, conditional score %.1f "
+                  "(p=%.2g)%s, gamma=%.3g",
+                  alarm_.input.c_str(), alarm_.output.c_str(), l.score, l.score_threshold, l.score_window,
+                  c.score_conditional, alarm_.p_value, c.located_by_gamma ? " named by gamma" : "", c.gamma);
   } else {
-    std::snprintf(text, sizeof text, "cleared: %s -> %s agrees with the model again: F=%.4g, LR %.1f < %.1f",
-                  alarm_.input.c_str(), alarm_.output.c_str(), c.f_conditional, c.lr_conditional,
-                  monitor_.clear_threshold());
+    std::snprintf(text, sizeof text, "cleared: %s -> %s agrees with the model again: F=%.4g",
+                  alarm_.input.c_str(), alarm_.output.c_str(), c.f_conditional);
   }
   alarm_.text = text;
   log::write(c.alarm ? log::Level::kWarning : log::Level::kNotice, "controller '%s': %s (sample %" PRId64 ")",
@@ -352,8 +357,9 @@ void MonitorService::fill_status(msg::Status& out, std::int64_t utime, std::int6
   out.uptime_ms = uptime_ms;
   out.ready = monitor_.ready() && !stale_;
   out.effective_samples = monitor_.effective_samples();
-  out.raise_threshold = monitor_.raise_threshold();
-  out.clear_threshold = monitor_.clear_threshold();
+  // The live detector's levels (its first window's: the others are in the log).
+  out.raise_threshold = monitor_.detector().threshold(0);
+  out.clear_threshold = monitor_.detector().clear_level(0);
   out.samples_seen = static_cast<std::int64_t>(counters_.seen);
   out.samples_used = static_cast<std::int64_t>(mc.used);
   out.dropped = static_cast<std::int64_t>(counters_.dropped);

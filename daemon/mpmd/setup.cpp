@@ -23,8 +23,9 @@ std::string fingerprint(const config::DaemonConfig& c) {
   std::ostringstream f;
   f.precision(17);
   f << c.controller_id << '\n'
-    << m.ar_order << ' ' << m.input_order << ' ' << m.forgetting << ' ' << m.false_alarm << ' ' << m.clear_ratio
-    << ' ' << m.raise_after << ' ' << m.clear_after << ' ' << m.warmup << ' ' << m.gamma_lambda << ' '
+    << m.ar_order << ' ' << m.input_order << ' ' << m.forgetting << ' ' << m.false_alarm << ' '
+    << m.detector.false_alarms_per_year << ' ' << m.detector.sample_time << ' ' << m.detector.crossing_constant << ' '
+    << m.outlier_limit << ' ' << m.warmup << ' ' << m.gamma_lambda << ' '
     << m.input_pole << ' ' << c.input_pole_auto << ' ' << c.plain_lags << ' ' << c.settle_samples << ' '
     << c.log_interval << ' ' << c.max_sequence_jump << ' ' << c.stale_after << '\n'
     << c.plant_path << '\n'

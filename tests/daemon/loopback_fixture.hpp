@@ -65,7 +65,7 @@ class LoopbackTest : public ::testing::TestWithParam<transport::Kind> {
 
   std::string monitor_yaml() const {
     return "monitor: {ar_order: 5, input_order: 10, forgetting: 0.995, false_alarm: 1.0e-5,\n"
-           "          raise_after: 20, clear_after: 50, settle_samples: 100}\n";
+           "          settle_samples: 100}\n";
   }
   std::string transport_yaml() const {
     return std::string("transport:\n  kind: ") + transport::to_string(settings_.kind) + "\n" +

@@ -22,8 +22,6 @@ inline MonitorSettings fast_settings() {
   s.input_order = 10;  // covers G21's 8-sample delay
   s.forgetting = 0.995;
   s.false_alarm = 1e-5;
-  s.raise_after = 20;
-  s.clear_after = 50;
   return s;
 }
 

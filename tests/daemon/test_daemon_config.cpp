@@ -46,8 +46,8 @@ TEST(DaemonConfig, MinimalFileTakesTheDefaults) {
 TEST(DaemonConfig, EverySettingIsRead) {
   const auto c = parse_daemon_config(
       "controller_id: c1\nplant: " + kPlant +
-          "\nmonitor: {ar_order: 4, input_order: 12, forgetting: 0.99, false_alarm: 1e-4, clear_ratio: 0.4,\n"
-          "  raise_after: 5, clear_after: 7, warmup: 300, gamma_lambda: 0.2, input_pole: auto,\n"
+          "\nmonitor: {ar_order: 4, input_order: 12, forgetting: 0.99, false_alarm: 1e-4, false_alarms_per_year: 4,\n"
+          "  sample_time: 2, outlier_limit: 7, detector_thresholds: [50, 51, 52, 53], warmup: 300, gamma_lambda: 0.2, input_pole: auto,\n"
           "  regressors: plain_lags, settle_samples: 50}\n"
           "transport:\n  kind: dds\n  lcm: {url: 'udpm://239.255.76.67:7700?ttl=1', sample_channel: S, alarm_channel: A,"
           " status_channel: T}\n"
@@ -59,9 +59,10 @@ TEST(DaemonConfig, EverySettingIsRead) {
   EXPECT_EQ(c.monitor.input_order, 12);
   EXPECT_EQ(c.monitor.forgetting, 0.99);
   EXPECT_EQ(c.monitor.false_alarm, 1e-4);
-  EXPECT_EQ(c.monitor.clear_ratio, 0.4);
-  EXPECT_EQ(c.monitor.raise_after, 5);
-  EXPECT_EQ(c.monitor.clear_after, 7);
+  EXPECT_EQ(c.monitor.detector.false_alarms_per_year, 4.0);
+  EXPECT_EQ(c.monitor.detector.sample_time, 2.0);
+  EXPECT_EQ(c.monitor.outlier_limit, 7.0);
+  EXPECT_EQ(c.monitor.detector.thresholds, (std::vector<double>{50, 51, 52, 53}));
   EXPECT_EQ(c.monitor.warmup, 300);
   EXPECT_EQ(c.monitor.gamma_lambda, 0.2);
   EXPECT_TRUE(c.input_pole_auto);

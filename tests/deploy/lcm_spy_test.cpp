@@ -96,7 +96,7 @@ TEST(LcmSpy, ShowsOurAlarmsDecoded) {
   settings.lcm.url = "udpm://239.255.76.69:" + std::to_string(21000 + ::getpid() % 1000) + "?ttl=0";
   dir.write("mpmd.yaml", "controller_id: wb\nplant: " MPM_SOURCE_DIR "/config/wood-berry.yaml\n"
                          "monitor: {ar_order: 5, input_order: 10, forgetting: 0.995, false_alarm: 1.0e-5,\n"
-                         "          raise_after: 20, clear_after: 50, settle_samples: 100}\n"
+                         "          settle_samples: 100}\n"
                          "transport: {kind: lcm, lcm: {url: \"" + settings.lcm.url + "\"}}\n"
                          "status_period: 0.1\n");
   ChildProcess mpmd({kMpmd, "--config", dir.file("mpmd.yaml")}, dir.file("mpmd.out"), dir.file("mpmd.err"));

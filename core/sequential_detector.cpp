@@ -1,0 +1,218 @@
+#include "core/sequential_detector.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/chi_square.hpp"
+
+namespace mpm {
+namespace {
+
+constexpr double kSecondsPerYear = 365.25 * 86400.0;
+
+double log_chi_square_density(double h, double dof) noexcept {
+  const double k = 0.5 * dof;
+  return (k - 1.0) * std::log(h) - 0.5 * h - k * std::log(2.0) - std::lgamma(k);
+}
+
+}  // namespace
+
+std::string DetectorSettings::validate() const {
+  std::ostringstream e;
+  if (!(false_alarms_per_year > 0.0 && false_alarms_per_year <= 1e9))
+    e << "false_alarms_per_year must be in (0, 1e9], got " << false_alarms_per_year << "; ";
+  if (!(sample_time >= 0.0 && sample_time <= 1e6)) e << "sample_time must be in [0, 1e6] s (0: the plant's), got " << sample_time << "; ";
+  if (windows < 1 || windows > 16) e << "detector windows must be in [1, 16], got " << windows << "; ";
+  if (!(first_window == 0.0 || (first_window >= 2.0 && first_window <= 1e7)))
+    e << "first_window must be 0 (auto) or in [2, 1e7], got " << first_window << "; ";
+  if (!(window_ratio >= 1.5 && window_ratio <= 100.0)) e << "window_ratio must be in [1.5, 100], got " << window_ratio << "; ";
+  if (!(crossing_constant > 0.0 && crossing_constant <= 100.0))
+    e << "crossing_constant must be in (0, 100], got " << crossing_constant << "; ";
+  if (!(clear_fraction >= 0.0 && clear_fraction < 1.0)) e << "clear_fraction must be in [0, 1), got " << clear_fraction << "; ";
+  if (!thresholds.empty() && thresholds.size() != static_cast<std::size_t>(windows))
+    e << "detector thresholds: need one per window (" << windows << "), got " << thresholds.size() << "; ";
+  for (double h : thresholds)
+    if (!(std::isfinite(h) && h > 0.0)) e << "detector thresholds must be finite and > 0, got " << h << "; ";
+  if (rate_per_sample() >= 0.1) e << "false_alarms_per_year x sample_time is more than 0.1 alarms per sample; ";
+  return e.str();
+}
+
+double DetectorSettings::rate_per_sample() const noexcept {
+  return false_alarms_per_year * (sample_time > 0.0 ? sample_time : 1.0) / kSecondsPerYear;
+}
+
+double crossing_rate(double h, double dof, double window, double period, double c) noexcept {
+  if (!(h > dof)) return INFINITY;
+  return c * std::exp(log_chi_square_density(h, dof)) * 2.0 * (h - dof) / window *
+         std::exp(-kOvershootBeta * std::sqrt(period / window));
+}
+
+double crossing_threshold(double rate, double dof, double window, double period, double c) noexcept {
+  // The rate rises from 0 at h = dof, peaks, then falls: bisect on log rate
+  // from well above the peak (dof + 2 sqrt(2 dof) + 2 is past it).
+  double lo = dof + 2.0 * std::sqrt(2.0 * dof) + 2.0;
+  double hi = lo;
+  const double target = std::log(rate);
+  const auto log_rate = [&](double h) { return std::log(crossing_rate(h, dof, window, period, c)); };
+  // Never below the chi-square's 1e-2 upper quantile: the formula holds for
+  // high levels only, and a window whose share of a high stated rate would
+  // need a level in the bulk of the distribution (a long window at a rate
+  // of one alarm in 10^4 samples) contributes less than its share instead.
+  lo = std::max(lo, chi_square_quantile_upper(1e-2, dof));
+  if (log_rate(lo) <= target) return lo;
+  while (log_rate(hi) > target && hi < 1e6) hi *= 2.0;
+  for (int it = 0; it < 200 && hi - lo > 1e-9 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (log_rate(mid) > target ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+SequentialDetector::SequentialDetector(std::size_t outputs, std::size_t dof, const DetectorSettings& settings,
+                                       std::size_t outputs_sharing_rate, double long_period, double first_period)
+    : outputs_(outputs), dof_(dof) {
+  const std::vector<double>& thresholds = settings.thresholds;
+  if (const std::string err = settings.validate(); !err.empty()) throw std::invalid_argument(err);
+  if (dof == 0) throw std::invalid_argument("SequentialDetector: need at least one degree of freedom");
+  const auto k = static_cast<Eigen::Index>(settings.windows);
+  if (!thresholds.empty() && thresholds.size() != static_cast<std::size_t>(k))
+    throw std::invalid_argument("detector thresholds: need one per window");
+  window_.resize(k);
+  rho_.resize(k);
+  var_factor_.resize(k);
+  threshold_.resize(k);
+  clear_.resize(k);
+  const double share =
+      settings.rate_per_sample() / static_cast<double>(std::max<std::size_t>(outputs_sharing_rate, 1) * static_cast<std::size_t>(k));
+  const auto d = static_cast<double>(dof);
+  for (Eigen::Index w = 0; w < k; ++w) {
+    window_[w] = settings.first_window * std::pow(settings.window_ratio, static_cast<double>(w));
+    rho_[w] = 1.0 - 1.0 / window_[w];
+    var_factor_[w] = 1.0 - rho_[w] * rho_[w];
+    threshold_[w] = thresholds.empty() ? crossing_threshold(share, d, window_[w], w == 0 ? first_period : long_period, settings.crossing_constant)
+                                       : thresholds[static_cast<std::size_t>(w)];
+    if (!(std::isfinite(threshold_[w]) && threshold_[w] > 0.0))
+      throw std::invalid_argument("detector thresholds must be finite and > 0");
+    clear_[w] = d + settings.clear_fraction * std::max(threshold_[w] - d, 0.0);
+  }
+  sums_.resize(static_cast<Eigen::Index>(dof), static_cast<Eigen::Index>(outputs * static_cast<std::size_t>(k)));
+  last_.assign(outputs * static_cast<std::size_t>(k), 0.0);
+  raised_.assign(outputs, 0);
+  cursor_.assign(outputs, 0);
+  info_.assign(outputs * static_cast<std::size_t>(k), Eigen::MatrixXd());
+  chol_.assign(outputs * static_cast<std::size_t>(k), Eigen::LLT<Eigen::MatrixXd>());
+  for (std::size_t j = 0; j < outputs; ++j)
+    for (Eigen::Index w = 1; w < k; ++w) {
+      info_[j * static_cast<std::size_t>(k) + static_cast<std::size_t>(w)] = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(dof), static_cast<Eigen::Index>(dof));
+      chol_[j * static_cast<std::size_t>(k) + static_cast<std::size_t>(w)] = Eigen::LLT<Eigen::MatrixXd>(static_cast<Eigen::Index>(dof));
+    }
+  info_ok_.assign(outputs * static_cast<std::size_t>(k), 0);
+  var_.assign(outputs * static_cast<std::size_t>(k), 0.0);
+  var_norm_.assign(outputs * static_cast<std::size_t>(k), 0.0);
+  solve_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(dof));
+  reset();
+}
+
+void SequentialDetector::accumulate(std::size_t j, const double* x, double scale, double squared_error) noexcept {
+  const std::size_t kw = windows();
+  const auto d = static_cast<Eigen::Index>(dof_);
+  for (std::size_t w = 0; w < kw; ++w) {
+    const double r2 = rho_[static_cast<Eigen::Index>(w)] * rho_[static_cast<Eigen::Index>(w)];
+    var_[j * kw + w] = r2 * var_[j * kw + w] + squared_error;
+    var_norm_[j * kw + w] = r2 * var_norm_[j * kw + w] + 1.0;
+    double* s = sums_.col(static_cast<Eigen::Index>(j * kw + w)).data();
+    const double r = rho_[static_cast<Eigen::Index>(w)];
+    for (Eigen::Index i = 0; i < d; ++i) s[i] = r * s[i] + scale * x[i];
+  }
+}
+
+void SequentialDetector::information_inverse(std::size_t j, std::size_t k, Eigen::MatrixXd& out) const noexcept {
+  out.setIdentity();
+  chol_[j * windows() + k].solveInPlace(out);
+}
+
+DetectorEvent SequentialDetector::test(std::size_t j, std::size_t k, double t) noexcept {
+  const std::size_t kw = windows();
+  last_[j * kw + k] = t;
+  if (!raised_[j]) {
+    if (t > threshold_[static_cast<Eigen::Index>(k)]) {
+      raised_[j] = 1;
+      return DetectorEvent::kRaised;
+    }
+    return DetectorEvent::kNone;
+  }
+  for (std::size_t w = 0; w < kw; ++w)
+    if (!(last_[j * kw + w] < clear_[static_cast<Eigen::Index>(w)])) return DetectorEvent::kNone;
+  raised_[j] = 0;
+  return DetectorEvent::kCleared;
+}
+
+std::size_t SequentialDetector::strongest(std::size_t j) const noexcept {
+  std::size_t best = 0;
+  for (std::size_t w = 1; w < windows(); ++w)
+    if (last_[j * windows() + w] / threshold_[static_cast<Eigen::Index>(w)] >
+        last_[j * windows() + best] / threshold_[static_cast<Eigen::Index>(best)])
+      best = w;
+  return best;
+}
+
+void SequentialDetector::reset_output(std::size_t j) noexcept {
+  const std::size_t kw = windows();
+  for (std::size_t w = 0; w < kw; ++w) {
+    sums_.col(static_cast<Eigen::Index>(j * kw + w)).setZero();
+    last_[j * kw + w] = 0.0;
+    if (!var_.empty()) var_[j * kw + w] = var_norm_[j * kw + w] = 0.0;
+  }
+  raised_[j] = 0;
+  cursor_[j] = 0;
+  for (std::size_t w = 1; w < kw; ++w) {
+    info_[j * kw + w].setZero();
+    info_ok_[j * kw + w] = 0;
+  }
+}
+
+void SequentialDetector::refresh_information(std::size_t j, std::size_t k, const Eigen::MatrixXd& per_sample,
+                                             double gap) noexcept {
+  const std::size_t i = j * windows() + k;
+  const double r2 = rho_[static_cast<Eigen::Index>(k)] * rho_[static_cast<Eigen::Index>(k)];
+  const double decay = std::pow(r2, gap);
+  // The samples since the last refresh, each with its weight rho^2j, carry
+  // the current per-sample information.
+  const double weight = (1.0 - decay) / (1.0 - r2);
+  info_[i] *= decay;
+  info_[i].noalias() += weight * per_sample;
+  chol_[i].compute(info_[i]);
+  info_ok_[i] = chol_[i].info() == Eigen::Success ? 1 : 0;
+}
+
+double SequentialDetector::normalised_quadratic(std::size_t j, std::size_t k) noexcept {
+  const std::size_t i = j * windows() + k;
+  solve_ = sums_.col(static_cast<Eigen::Index>(i));
+  chol_[i].matrixL().solveInPlace(solve_);
+  return solve_.squaredNorm();
+}
+
+void SequentialDetector::reset() noexcept {
+  for (std::size_t j = 0; j < outputs_; ++j) reset_output(j);
+}
+
+void SequentialDetector::adopt_output(const SequentialDetector& part, std::size_t j) noexcept {
+  const std::size_t kw = windows();
+  for (std::size_t w = 0; w < kw; ++w) {
+    sums_.col(static_cast<Eigen::Index>(j * kw + w)) = part.sums_.col(static_cast<Eigen::Index>(j * kw + w));
+    last_[j * kw + w] = part.last_[j * kw + w];
+    var_[j * kw + w] = part.var_[j * kw + w];
+    var_norm_[j * kw + w] = part.var_norm_[j * kw + w];
+  }
+  raised_[j] = part.raised_[j];
+  cursor_[j] = part.cursor_[j];
+  for (std::size_t w = 1; w < kw; ++w) {
+    info_[j * kw + w] = part.info_[j * kw + w];
+    info_ok_[j * kw + w] = part.info_ok_[j * kw + w];
+    chol_[j * kw + w] = part.chol_[j * kw + w];
+  }
+}
+
+}  // namespace mpm

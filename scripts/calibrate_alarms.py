@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+"""Full calibration of the live alarm path (issue 11): no-mismatch closed loops
+of Wood-Berry, the 3x3 and the quadruple tank (mpm simulate --scenario
+plant-nominal), each replayed through the live monitor (mpm monitor --events,
+mpmd's forgetting 0.999) at a stated rate high enough to observe (default one
+false alarm per 2e4 samples per controller). Prints, per plant and in all,
+raises against the stated count with a 95 % Poisson interval, and the split
+between the first and second half of the runs (flat in time).
+
+usage: scripts/calibrate_alarms.py [--mpm build/daemon/mpm] [--runs 500]
+                                   [--samples 10000] [--per-alarm 2e4] [--seed 1]
+"""
+import argparse, json, math, os, subprocess, sys, tempfile
+
+PLANTS = ["wood-berry.yaml", "three-by-three.yaml", "quad-tank.yaml"]
+SECONDS_PER_YEAR = 365.25 * 86400
+
+
+def poisson_cdf(k, mu):
+    term, total = math.exp(-mu), 0.0
+    for i in range(k + 1):
+        if i:
+            term *= mu / i
+        total += term
+    return total
+
+
+def poisson_interval(n, level=0.95):
+    a = (1 - level) / 2
+
+    def solve(f, lo, hi):
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if f(mid) else (lo, mid)
+        return 0.5 * (lo + hi)
+
+    lower = 0.0 if n == 0 else solve(lambda mu: 1 - poisson_cdf(n - 1, mu) < a, 0.0, n + 10 * math.sqrt(n) + 10)
+    upper = solve(lambda mu: poisson_cdf(n, mu) > a, 0.0, n + 10 * math.sqrt(n) + 20)
+    return lower, upper
+
+
+def sample_time(path):
+    for line in open(path):
+        if line.startswith("sample_time:"):
+            return float(line.split(":")[1].split("#")[0])
+    return 1.0
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    root = os.path.dirname(here)
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--mpm", default=os.path.join(root, "build", "daemon", "mpm"))
+    ap.add_argument("--runs", type=int, default=500, help="runs in all, split over the plants")
+    ap.add_argument("--samples", type=int, default=10000)
+    ap.add_argument("--per-alarm", type=float, default=2e4, help="stated samples per false alarm")
+    ap.add_argument("--seed", type=int, default=1)
+    args = ap.parse_args()
+    rows, total = [], {"raises": 0, "samples": 0, "first": 0}
+    with tempfile.TemporaryDirectory() as tmp:
+        csv = os.path.join(tmp, "run.csv")
+        for p_index, plant_file in enumerate(PLANTS):
+            plant = os.path.join(root, "config", plant_file)
+            rate = SECONDS_PER_YEAR / (args.per_alarm * sample_time(plant))
+            runs = args.runs // len(PLANTS) + (1 if p_index < args.runs % len(PLANTS) else 0)
+            raises = first = monitored = 0
+            for r in range(runs):
+                seed = args.seed + 1000 * p_index + r
+                subprocess.run([args.mpm, "simulate", "--scenario", "plant-nominal", "--plant", plant, "--samples",
+                                str(args.samples), "--seed", str(seed), "--out", csv], check=True,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                out = subprocess.run([args.mpm, "monitor", "--plant", plant, "--data", csv, "--forgetting", "0.999",
+                                      "--events", "--false-alarms-per-year", repr(rate)], check=True,
+                                     capture_output=True, text=True).stdout
+                summary = json.loads(subprocess.run([args.mpm, "monitor", "--plant", plant, "--data", csv,
+                                                     "--forgetting", "0.999", "--json", "--threads", "1",
+                                                     "--false-alarms-per-year", repr(rate)],
+                                                    check=True, capture_output=True, text=True).stdout)
+                used = summary["counters"]["used"]
+                monitored += used
+                for line in out.splitlines():
+                    e = json.loads(line)
+                    if e["event"] == "raised":
+                        raises += 1
+                        first += e["sample"] < args.samples / 2
+                os.unlink(csv)
+                print(f"\r{plant_file}: run {r + 1}/{runs}, {raises} raises", end="", file=sys.stderr, flush=True)
+            print(file=sys.stderr)
+            rows.append((plant_file, runs, monitored, raises, first))
+            total["raises"] += raises
+            total["samples"] += monitored
+            total["first"] += first
+    print(f"stated: one false alarm per {args.per_alarm:g} samples per controller; {args.samples} samples per run")
+    print(f"{'plant':22s} {'runs':>5s} {'samples':>10s} {'raises':>7s} {'stated':>8s} {'ratio':>6s} {'95% CI':>13s} {'1st/2nd half':>13s}")
+    for name, runs, n, k, first in rows + [("all", sum(r[1] for r in rows), total["samples"], total["raises"], total["first"])]:
+        expected = n / args.per_alarm
+        lo, hi = poisson_interval(k)
+        print(f"{name:22s} {runs:5d} {n:10d} {k:7d} {expected:8.1f} {k / expected:6.2f} {lo / expected:6.2f}-{hi / expected:<6.2f} {first:6d}/{k - first:<6d}")
+
+
+if __name__ == "__main__":
+    main()
