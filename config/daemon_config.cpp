@@ -133,6 +133,14 @@ void read_service(const YamlReader& r, const Field& root, DaemonConfig& c) {
   if (c.log_interval < 0) r.fail(r.child(root, "log_interval"), "expected seconds >= 0");
 }
 
+void read_checkpoint(const YamlReader& r, const Field& root, const std::string& base_dir, DaemonConfig& c) {
+  read(r, root, "checkpoint_path", c.checkpoint_path);
+  if (!c.checkpoint_path.empty()) c.checkpoint_path = resolve(c.checkpoint_path, base_dir);
+  read(r, root, "checkpoint_interval", c.checkpoint_interval);
+  if (!(c.checkpoint_interval >= 0.05 && c.checkpoint_interval <= 86400))
+    r.fail(r.child(root, "checkpoint_interval"), "expected seconds in 0.05..86400");
+}
+
 }  // namespace
 
 DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string& source_name,
@@ -147,7 +155,7 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
   const Field root = r.root(document);
   try {
     r.check_keys(root, {"controller_id", "plant", "monitor", "transport", "status_period", "queue_capacity",
-                        "log_interval"});
+                        "log_interval", "checkpoint_path", "checkpoint_interval"});
     DaemonConfig c;
     c.source = source_name;
     c.controller_id = r.name(r.child(root, "controller_id"));
@@ -157,6 +165,7 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
     read_monitor(r, root, c);
     read_transport(r, root, base_dir, c);
     read_service(r, root, c);
+    read_checkpoint(r, root, base_dir, c);
     return c;
   } catch (const YAML::Exception& e) {
     throw yaml_error(e, source_name, "unexpected structure");

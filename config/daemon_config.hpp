@@ -19,6 +19,8 @@
 //   status_period: 1.0              # seconds
 //   queue_capacity: 4096            # samples between receiver and monitor
 //   log_interval: 60                # seconds between repeats of one kind of log line
+//   checkpoint_path: /var/lib/mpm/mpmd.state  # relative to this file; absent = no checkpoint
+//   checkpoint_interval: 60         # seconds between checkpoints (also written at SIGTERM)
 #pragma once
 
 #include <string>
@@ -40,6 +42,8 @@ struct DaemonConfig {
   double status_period = 1.0;  // seconds between status messages
   int queue_capacity = 4096;   // samples buffered between receiver and monitor
   double log_interval = 60.0;  // seconds between repeats of one kind of log line
+  std::string checkpoint_path; // monitor state saved here and resumed at start; "" = none
+  double checkpoint_interval = 60.0;  // seconds between checkpoints (and one at SIGTERM)
 };
 
 // `base_dir` resolves relative paths (plant, DDS config); "" = as given.

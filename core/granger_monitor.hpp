@@ -99,6 +99,11 @@ struct ChannelStats {
                                // paper's locating rule
   int above = 0;               // consecutive samples above the raise level
   int below = 0;               // consecutive samples below the clear level
+  template <class V>
+  void visit_state(V&& v) {  // every field: a checkpoint restores them all
+    v(f_pairwise); v(f_conditional); v(lr_pairwise); v(lr_conditional); v(gamma); v(alarm);
+    v(located_by_gamma); v(above); v(below);
+  }
 };
 
 struct LoopStats {
@@ -111,6 +116,11 @@ struct LoopStats {
   double residual_variance = 0.0;// weighted variance of d~ about its mean
   bool alarm = false;            // joint test raised, or any channel raised
   bool diverging = false;        // residual variance growing without bound
+  template <class V>
+  void visit_state(V&& v) {
+    v(lr_joint); v(joint_alarm); v(above); v(below); v(sigma1); v(sigma_full); v(residual_variance);
+    v(alarm); v(diverging);
+  }
 };
 
 struct MonitorCounters {
@@ -118,6 +128,10 @@ struct MonitorCounters {
   std::uint64_t used = 0;        // samples that entered the statistics
   std::uint64_t missing = 0;     // samples with NaN/inf skipped
   std::uint64_t gaps = 0;        // runs of missing samples
+  template <class V>
+  void visit_state(V&& v) {
+    v(samples); v(used); v(missing); v(gaps);
+  }
 };
 
 // The outputs a monitor models: [first, first + count), clipped to the
@@ -195,6 +209,16 @@ class GrangerMonitor {
   // of the same plant and settings fed the same samples. Not real-time
   // (copies factors); throws std::invalid_argument when they do not match.
   void adopt_outputs(const GrangerMonitor& part);
+
+  // Calls v(member) for every member that changes after setup, in a fixed
+  // order: what a checkpoint saves and restores (daemon/mpmd/checkpoint.hpp).
+  // Settings, thresholds and scratch are rebuilt by the constructor.
+  template <class V>
+  void visit_state(V&& v) {
+    v(residual_lags_); v(input_lags_); v(channel_filters_); v(lags_filled_); v(input_ref_);
+    v(regressions_); v(channels_); v(loops_); v(counters_); v(in_gap_); v(used_since_reset_);
+    v(sum_w_); v(sum_w2_); v(n_eq_); v(mean_fast_); v(var_fast_); v(var_baseline_);
+  }
 
  private:
   void absorb_sample(const double* residual) noexcept;

@@ -99,6 +99,14 @@ class NestedRls {
   // Back to the prior.
   void reset() noexcept;
 
+  // Calls v(member) for every member that changes after setup, in a fixed
+  // order: what a checkpoint saves and restores (daemon/mpmd/checkpoint.hpp).
+  template <class V>
+  void visit_state(V&& v) {
+    v(since_prior_); v(next_prior_row_); v(top_); v(top_d_); v(lower_); v(lower_wald_); v(pairs_);
+    v(row_); v(row_weight_);
+  }
+
  private:
   std::size_t a_ = 0;
   std::size_t m_ = 0;

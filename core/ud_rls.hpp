@@ -68,6 +68,13 @@ class UdRls {
   const Eigen::VectorXd& weights() const noexcept { return d_; }
   void reset() noexcept;
 
+  // Calls v(member) for every member that changes after setup, in a fixed
+  // order: what a checkpoint saves and restores (daemon/mpmd/checkpoint.hpp).
+  template <class V>
+  void visit_state(V&& v) {
+    v(since_prior_); v(next_prior_row_); v(u_); v(d_); v(work_); v(work_weight_); v(changes_);
+  }
+
  private:
   std::size_t p_ = 0;
   double lambda_ = 1.0;

@@ -173,6 +173,26 @@ void MonitorService::fill_alarm_header(std::size_t output, std::size_t input, st
   alarm_.input_index = static_cast<std::int32_t>(input);
 }
 
+void MonitorService::republish_raised(const std::string& reason) {
+  const std::size_t n_in = plant_.n_inputs();
+  for (std::size_t j = 0; j < plant_.n_outputs(); ++j) {
+    for (std::size_t i = 0; i < n_in; ++i) {
+      if (!alarm_state_[j * n_in + i]) continue;
+      const ChannelStats& c = monitor_.channel(j, i);
+      fill_alarm_header(j, i, 0, tracker_.last());
+      alarm_.raised = true;
+      alarm_.f = c.f_conditional;
+      alarm_.p_value = monitor_.p_value(c.lr_conditional);
+      alarm_.gamma = c.gamma;
+      alarm_.physics.clear();
+      alarm_.text = "still raised: model-plant mismatch on " + alarm_.input + " -> " + alarm_.output + " (" +
+                    reason + ")";
+      log::write(log::Level::kWarning, "controller '%s': %s", settings_.controller_id.c_str(), alarm_.text.c_str());
+      if (on_alarm_) on_alarm_(alarm_);
+    }
+  }
+}
+
 void MonitorService::retire(const std::string& reason) {
   const std::size_t n_in = plant_.n_inputs();
   for (std::size_t j = 0; j < plant_.n_outputs(); ++j) {

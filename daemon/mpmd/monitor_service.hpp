@@ -55,6 +55,11 @@ struct ServiceCounters {
   std::uint64_t nan_samples = 0;
   std::uint64_t dropped = 0;       // lost before the service (receive queue full)
   std::uint64_t foreign = 0;       // samples of other controllers, ignored
+  template <class V>
+  void visit_state(V&& v) {  // checkpoint
+    v(seen); v(gaps); v(missing); v(duplicates); v(out_of_order); v(restarts); v(malformed); v(nan_samples);
+    v(dropped); v(foreign);
+  }
 };
 
 class MonitorService {
@@ -87,7 +92,28 @@ class MonitorService {
   const PlantModel& plant() const noexcept { return plant_; }
   const ServiceSettings& settings() const noexcept { return settings_; }
   int settle_samples() const noexcept { return settle_; }
+  std::int64_t last_sequence() const noexcept { return tracker_.last(); }
   const AlarmSink& alarm_sink() const noexcept { return on_alarm_; }
+
+  // Publishes a "raised" alarm again for every channel raised now, saying
+  // why (the service resumed from a checkpoint): listeners that saw the
+  // previous process die learn the alarm still stands.
+  void republish_raised(const std::string& reason);
+
+  // Calls v(member) for everything that changes after setup (checkpoint.hpp):
+  // the residual model (made at the first complete sample when the plant
+  // file gives no operating point), the sequence, counters, settling and
+  // alarm states, and the monitor. Throttles start afresh.
+  template <class V>
+  void visit_state(V&& v) {
+    bool has_residuals = residuals_.has_value();
+    v(has_residuals);
+    // On reading: a placeholder u0, overwritten by the residual model's own state.
+    if (has_residuals && !residuals_) residuals_.emplace(plant_, std::vector<double>(plant_.n_inputs(), 0.0));
+    if (!has_residuals) residuals_.reset();
+    if (residuals_) v(*residuals_);
+    v(tracker_); v(counters_); v(settling_); v(alarm_state_); v(monitor_);
+  }
 
  private:
   bool sized_right(const msg::Sample& s) const noexcept;
