@@ -21,6 +21,7 @@
 //   log_interval: 60                # seconds between repeats of one kind of log line
 //   checkpoint_path: /var/lib/mpm/mpmd.state  # relative to this file; absent = no checkpoint
 //   checkpoint_interval: 60         # seconds between checkpoints (also written at SIGTERM)
+//   diagnosis_window: 3000          # samples diagnosed (physics) at a raise; 0 = off
 #pragma once
 
 #include <string>
@@ -44,6 +45,7 @@ struct DaemonConfig {
   double log_interval = 60.0;  // seconds between repeats of one kind of log line
   std::string checkpoint_path; // monitor state saved here and resumed at start; "" = none
   double checkpoint_interval = 60.0;  // seconds between checkpoints (and one at SIGTERM)
+  int diagnosis_window = 3000; // recent samples diagnosed when an output is raised; 0 = none
 };
 
 // `base_dir` resolves relative paths (plant, DDS config); "" = as given.

@@ -26,5 +26,7 @@ void to_wire(const msg::Status& in, mpm_dds_Status& out, Scratch& scratch);
 void from_wire(const mpm_dds_Sample& in, msg::Sample& out);
 void from_wire(const mpm_dds_Alarm& in, msg::Alarm& out);
 void from_wire(const mpm_dds_Status& in, msg::Status& out);
+void to_wire(const msg::Diagnosis& in, mpm_dds_Diagnosis& out, Scratch& scratch);
+void from_wire(const mpm_dds_Diagnosis& in, msg::Diagnosis& out);
 
 }  // namespace mpm::transport::dds_codec

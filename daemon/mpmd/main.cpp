@@ -125,6 +125,7 @@ int main(int argc, char** argv) {
   }
   transport->advertise(transport::Transport::Topic::kAlarm);
   transport->advertise(transport::Transport::Topic::kStatus);
+  transport->advertise(transport::Transport::Topic::kDiagnosis);
   if (resumed) service->republish_raised("the service restarted and resumed from its checkpoint");
   SampleQueue queue(static_cast<std::size_t>(loaded->config.queue_capacity));
   Receiver receiver(*transport, queue);

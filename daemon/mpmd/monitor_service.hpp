@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -26,6 +27,7 @@
 #include "core/granger_monitor.hpp"
 #include "core/mimo_model.hpp"
 #include "core/plant_model.hpp"
+#include "daemon/mpmd/diagnosis_worker.hpp"
 #include "daemon/mpmd/sequence_tracker.hpp"
 #include "daemon/mpmd/throttle.hpp"
 #include "transport/messages.hpp"
@@ -42,6 +44,9 @@ struct ServiceSettings {
   // gap) while its start-up transient decays; -1 = the plant's settling time.
   int settle_samples = -1;
   double log_interval = 60.0;  // seconds between repeats of one kind of log line
+  // Samples kept for the diagnosis of a raised output (diagnosis_worker.hpp);
+  // 0 = no diagnosis.
+  int diagnosis_window = 0;
 };
 
 struct ServiceCounters {
@@ -95,6 +100,20 @@ class MonitorService {
   std::int64_t last_sequence() const noexcept { return tracker_.last(); }
   const AlarmSink& alarm_sink() const noexcept { return on_alarm_; }
 
+  // Main thread, between samples: hands over a pending diagnosis request and
+  // passes each finished diagnosis to `publish`; the physics it names goes
+  // into the channel's later alarm messages (the clear, a resume).
+  template <class Publish>
+  void poll_diagnoses(Publish&& publish) {
+    if (!diagnosis_) return;
+    while (diagnosis_->take(diagnosis_msg_)) {
+      if (diagnosis_msg_.found) physics_[static_cast<std::size_t>(diagnosis_msg_.output_index) * plant_.n_inputs() +
+                                         static_cast<std::size_t>(diagnosis_msg_.input_index)] = diagnosis_msg_.physics;
+      publish(diagnosis_msg_);
+    }
+  }
+  const DiagnosisWorker* diagnosis() const noexcept { return diagnosis_.get(); }
+
   // Publishes a "raised" alarm again for every channel raised now, saying
   // why (the service resumed from a checkpoint): listeners that saw the
   // previous process die learn the alarm still stands.
@@ -138,6 +157,9 @@ class MonitorService {
   std::vector<double> nan_u_, nan_y_;        // a missing sample
   std::vector<std::uint8_t> alarm_state_;    // output-major, as published
   msg::Alarm alarm_;
+  std::unique_ptr<DiagnosisWorker> diagnosis_;  // null when diagnosis_window = 0
+  std::vector<std::string> physics_;           // per channel: the last diagnosis' physics word
+  msg::Diagnosis diagnosis_msg_;
 
   struct Throttles {
     Throttle foreign, gap, duplicate, out_of_order, restart, malformed, nan, dropped, receive_errors;

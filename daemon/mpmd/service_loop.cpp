@@ -54,6 +54,9 @@ int ServiceLoop::run(const std::atomic<bool>& stop, std::atomic<bool>& reload) {
       return 1;
     }
     drain(Clock::now());
+    service_->poll_diagnoses([this](const msg::Diagnosis& d) {
+      if (!transport_.publish(d)) log::write(log::Level::kError, "could not publish the diagnosis of %s", d.output.c_str());
+    });
     const auto now = Clock::now();
     account_losses(now);
     if (now >= next_status_) publish_status(now);

@@ -59,6 +59,7 @@ std::unique_ptr<MonitorService> make_service(const LoadedConfig& loaded, Monitor
   settings.plain_lags = loaded.config.plain_lags;
   settings.settle_samples = loaded.config.settle_samples;
   settings.log_interval = loaded.config.log_interval;
+  settings.diagnosis_window = loaded.config.diagnosis_window;
   try {
     return std::make_unique<MonitorService>(loaded.plant, settings, std::move(on_alarm));
   } catch (const std::exception& e) {
