@@ -165,7 +165,7 @@ void MonitorService::check_alarms(const msg::Sample& s) {
       alarm_state_[j * n_in + i] = now;
       if (now) physics_[j * n_in + i].clear();  // a new episode: its physics is not known yet
       publish_alarm(j, i, s);
-      if (now && diagnosis_) diagnosis_->request({j, i, s.utime, s.seq, settings_.controller_id});
+      if (now && diagnosis_) diagnosis_->request({j, i, alarm_.utime, s.seq, settings_.controller_id});
     }
   }
 }
