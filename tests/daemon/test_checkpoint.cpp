@@ -11,6 +11,7 @@
 #include <fstream>
 #include <random>
 
+#include "config/daemon_config.hpp"
 #include "daemon/mpmd/checkpoint.hpp"
 #include "service_fixture.hpp"
 #include "child_process.hpp"
@@ -236,6 +237,33 @@ TEST(Checkpoint, WrittenAtomicallyAndReadBack) {
   // A folder that does not exist: an error naming the path, nothing written.
   EXPECT_FALSE(checkpoint::write_atomically(dir.file("no/such/folder/state"), {1, 2, 3}, error));
   EXPECT_NE(error.find("no/such/folder"), std::string::npos) << error;
+}
+
+// The keys: the path relative to the configuration's folder, the interval's
+// range with a located error, and the diagnosis window's.
+TEST(Checkpoint, ConfigurationKeys) {
+  const std::string base = "controller_id: wb\nplant: wood-berry.yaml\n";
+  const auto none = config::parse_daemon_config(base, "mpmd.yaml", MPM_SOURCE_DIR "/config");
+  EXPECT_EQ(none.checkpoint_path, "");
+  EXPECT_EQ(none.checkpoint_interval, 60.0);
+  EXPECT_EQ(none.diagnosis_window, 3000);
+  const auto set = config::parse_daemon_config(base + "checkpoint_path: state/mpmd.state\ncheckpoint_interval: 5\n"
+                                               "diagnosis_window: 0\n",
+                                               "mpmd.yaml", MPM_SOURCE_DIR "/config");
+  EXPECT_EQ(set.checkpoint_path, MPM_SOURCE_DIR "/config/state/mpmd.state");
+  EXPECT_EQ(set.checkpoint_interval, 5.0);
+  EXPECT_EQ(set.diagnosis_window, 0);
+  const auto error_of = [&](const std::string& extra) {
+    try {
+      config::parse_daemon_config(base + extra, "mpmd.yaml", MPM_SOURCE_DIR "/config");
+    } catch (const config::ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error_of("checkpoint_interval: 0\n").find("mpmd.yaml:3"), std::string::npos);
+  EXPECT_NE(error_of("checkpoint_interval: 0\n").find("0.05..86400"), std::string::npos);
+  EXPECT_NE(error_of("diagnosis_window: 50\n").find("200..1000000"), std::string::npos);
 }
 
 }  // namespace
