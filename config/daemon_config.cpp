@@ -89,17 +89,19 @@ void read_monitor(const YamlReader& r, const Field& root, DaemonConfig& c) {
 void read_lcm(const YamlReader& r, const Field& t, transport::LcmSettings& lcm) {
   const Field f = r.child(t, "lcm");
   if (!f.present() || f.node.IsNull()) return;
-  r.check_keys(f, {"url", "sample_channel", "alarm_channel", "status_channel"});
+  r.check_keys(f, {"url", "sample_channel", "alarm_channel", "status_channel", "diagnosis_channel"});
   read(r, f, "url", lcm.url);
   read(r, f, "sample_channel", lcm.sample_channel);
   read(r, f, "alarm_channel", lcm.alarm_channel);
   read(r, f, "status_channel", lcm.status_channel);
+  read(r, f, "diagnosis_channel", lcm.diagnosis_channel);
 }
 
 void read_dds(const YamlReader& r, const Field& t, const std::string& base_dir, transport::DdsSettings& dds) {
   const Field f = r.child(t, "dds");
   if (!f.present() || f.node.IsNull()) return;
-  r.check_keys(f, {"domain", "config", "sample_topic", "alarm_topic", "status_topic", "sample_history"});
+  r.check_keys(f, {"domain", "config", "sample_topic", "alarm_topic", "status_topic", "diagnosis_topic",
+                   "sample_history"});
   read(r, f, "domain", dds.domain);
   if (dds.domain < 0 || dds.domain > 230) r.fail(r.child(f, "domain"), "expected a DDS domain id in 0..230");
   read(r, f, "config", dds.config);
@@ -112,6 +114,7 @@ void read_dds(const YamlReader& r, const Field& t, const std::string& base_dir, 
   read(r, f, "sample_topic", dds.sample_topic);
   read(r, f, "alarm_topic", dds.alarm_topic);
   read(r, f, "status_topic", dds.status_topic);
+  read(r, f, "diagnosis_topic", dds.diagnosis_topic);
   read(r, f, "sample_history", dds.sample_history);
   if (dds.sample_history < 1) r.fail(r.child(f, "sample_history"), "expected a history depth >= 1");
 }
@@ -148,6 +151,17 @@ void read_service(const YamlReader& r, const Field& root, DaemonConfig& c) {
   }
 }
 
+void read_checkpoint(const YamlReader& r, const Field& root, const std::string& base_dir, DaemonConfig& c) {
+  read(r, root, "checkpoint_path", c.checkpoint_path);
+  if (!c.checkpoint_path.empty()) c.checkpoint_path = resolve(c.checkpoint_path, base_dir);
+  read(r, root, "checkpoint_interval", c.checkpoint_interval);
+  if (!(c.checkpoint_interval >= 0.05 && c.checkpoint_interval <= 86400))
+    r.fail(r.child(root, "checkpoint_interval"), "expected seconds in 0.05..86400");
+  read(r, root, "diagnosis_window", c.diagnosis_window);
+  if (c.diagnosis_window != 0 && (c.diagnosis_window < 200 || c.diagnosis_window > 1000000))
+    r.fail(r.child(root, "diagnosis_window"), "expected 0 (off) or a number of samples in 200..1000000");
+}
+
 }  // namespace
 
 DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string& source_name,
@@ -162,7 +176,8 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
   const Field root = r.root(document);
   try {
     r.check_keys(root, {"controller_id", "plant", "monitor", "transport", "status_period", "queue_capacity",
-                        "log_interval", "max_sequence_jump", "stale_after"});
+                        "log_interval", "max_sequence_jump", "stale_after", "checkpoint_path",
+                        "checkpoint_interval", "diagnosis_window"});
     DaemonConfig c;
     c.source = source_name;
     c.controller_id = r.name(r.child(root, "controller_id"));
@@ -172,6 +187,7 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
     read_monitor(r, root, c);
     read_transport(r, root, base_dir, c);
     read_service(r, root, c);
+    read_checkpoint(r, root, base_dir, c);
     return c;
   } catch (const YAML::Exception& e) {
     throw yaml_error(e, source_name, "unexpected structure");

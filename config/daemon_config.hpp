@@ -22,6 +22,9 @@
 //   log_interval: 60                # seconds between repeats of one kind of log line
 //   max_sequence_jump: 1000000      # larger sequence jumps resynchronise (wire)
 //   stale_after: auto               # seconds without a usable sample: not ready
+//   checkpoint_path: /var/lib/mpm/mpmd.state  # relative to this file; absent = no checkpoint
+//   checkpoint_interval: 60         # seconds between checkpoints (also written at SIGTERM)
+//   diagnosis_window: 3000          # samples diagnosed (physics) at a raise; 0 = off
 #pragma once
 
 #include <cstdint>
@@ -46,6 +49,9 @@ struct DaemonConfig {
   double log_interval = 60.0;  // seconds between repeats of one kind of log line
   std::int64_t max_sequence_jump = 1000000;  // largest plausible sequence gap or step back
   double stale_after = -1.0;   // seconds without a usable sample -> not ready; -1 = auto, 0 = never
+  std::string checkpoint_path; // monitor state saved here and resumed at start; "" = none
+  double checkpoint_interval = 60.0;  // seconds between checkpoints (and one at SIGTERM)
+  int diagnosis_window = 3000; // recent samples diagnosed when an output is raised; 0 = none
 };
 
 // `base_dir` resolves relative paths (plant, DDS config); "" = as given.

@@ -75,18 +75,12 @@ class BiermanRls {
   void covariance_into(double* out, std::size_t ld) const noexcept;
   void reset() noexcept;
 
-  // Every member that changes after setup (for checkpointing).
+  // Calls v(member) for every member that changes after setup, in a fixed
+  // order: what a checkpoint saves and restores (daemon/mpmd/checkpoint.hpp).
   template <class V>
   void visit_state(V&& v) {
-    v(since_prior_);
-    v(next_prior_row_);
-    v(u_);
-    v(d_);
-    v(theta_);
-    v(block_cov_);
-    v(next_resync_);
-    v(rss_);
-    v(energy_);
+    v(since_prior_); v(next_prior_row_); v(u_); v(d_); v(theta_); v(h_); v(gain_); v(block_cov_);
+    v(next_resync_); v(staged_weight_); v(rss_); v(energy_);
   }
 
  private:

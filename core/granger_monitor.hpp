@@ -113,6 +113,11 @@ struct ChannelStats {
   bool located_by_gamma = false;  // named by the paper's rule (gamma < lambda^2,
                                // largest pairwise F) because no input's
                                // conditional score stood out on its own
+  template <class V>
+  void visit_state(V&& v) {  // every field: a checkpoint restores them all
+    v(f_pairwise); v(f_conditional); v(lr_pairwise); v(lr_conditional); v(gamma); v(score_conditional);
+    v(alarm); v(located_by_gamma);
+  }
 };
 
 struct LoopStats {
@@ -125,6 +130,11 @@ struct LoopStats {
   double residual_variance = 0.0;// weighted variance of d~ about its mean
   bool alarm = false;            // raised by the sequential detector
   bool diverging = false;        // residual variance growing without bound
+  template <class V>
+  void visit_state(V&& v) {
+    v(lr_joint); v(score); v(score_threshold); v(score_window); v(sigma1); v(sigma_full); v(residual_variance);
+    v(alarm); v(diverging);
+  }
 };
 
 struct MonitorCounters {
@@ -135,6 +145,10 @@ struct MonitorCounters {
   std::uint64_t outliers = 0;    // samples skipped beyond the robust bound
   std::uint64_t resets = 0;      // outputs restarted after non-finite statistics
   std::uint64_t raises = 0;      // raise events of the sequential detector
+  template <class V>
+  void visit_state(V&& v) {
+    v(samples); v(used); v(missing); v(gaps); v(outliers); v(resets); v(raises);
+  }
 };
 
 // The outputs a monitor models: [first, first + count), clipped to the
@@ -206,41 +220,6 @@ class GrangerMonitor {
   // Forgets everything learnt: statistics, lags, alarms (counters are kept).
   void reset() noexcept;
 
-  // Every member that changes after setup (for checkpointing).
-  template <class V>
-  void visit_state(V&& v) {
-    for (NestedRls& r : regressions_) r.visit_state(v);
-    v(residual_lags_);
-    v(input_lags_);
-    v(lags_filled_);
-    v(input_ref_);
-    v(counters_.samples);
-    v(counters_.used);
-    v(counters_.missing);
-    v(counters_.gaps);
-    v(counters_.outliers);
-    v(counters_.resets);
-    v(counters_.raises);
-    v(in_gap_);
-    v(used_since_reset_);
-    v(sum_w_);
-    v(sum_w2_);
-    v(n_eq_);
-    v(mean_fast_);
-    v(var_fast_);
-    v(var_baseline_);
-    v(output_used_);
-    v(output_sum_w_);
-    v(last_good_);
-    v(jump_scale_);
-    v(outlier_run_);
-    v(refresh_last_);
-    v(refresh_count_);
-    v(refresh_tick_);
-    v(refresh_cursor_);
-    detector_.visit_state(v);
-  }
-
   // The outputs this monitor models (all unless constructed with a range);
   // statistics of the others stay at their initial values.
   std::size_t first_modelled_output() const noexcept { return first_output_; }
@@ -249,6 +228,19 @@ class GrangerMonitor {
   // of the same plant and settings fed the same samples. Not real-time
   // (copies factors); throws std::invalid_argument when they do not match.
   void adopt_outputs(const GrangerMonitor& part);
+
+  // Calls v(member) for every member that changes after setup, in a fixed
+  // order: what a checkpoint saves and restores (daemon/mpmd/checkpoint.hpp).
+  // Settings, thresholds and scratch are rebuilt by the constructor.
+  template <class V>
+  void visit_state(V&& v) {
+    v(residual_lags_); v(input_lags_); v(channel_filters_); v(lags_filled_); v(input_ref_);
+    v(regressions_); v(channels_); v(loops_); v(counters_); v(in_gap_); v(used_since_reset_);
+    v(sum_w_); v(sum_w2_); v(n_eq_); v(mean_fast_); v(var_fast_); v(var_baseline_);
+    v(output_used_); v(output_sum_w_); v(last_good_); v(jump_scale_); v(outlier_run_);
+    v(refresh_last_); v(refresh_count_); v(refresh_tick_); v(refresh_cursor_);
+    detector_.visit_state(v);
+  }
 
  private:
   void absorb_sample(const double* residual) noexcept;

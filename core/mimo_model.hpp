@@ -24,12 +24,21 @@ class MimoModel {
   void step(const double* u, double* y) noexcept;
   // Back to rest at zero deviation.
   void reset() noexcept;
+  // Calls v(member) for every member that changes after setup (checkpoint).
+  template <class V>
+  void visit_state(V&& v) {
+    v(channels_);
+  }
 
  private:
   struct Channel {
     std::size_t output;
     std::size_t input;
     DiscreteFilter filter;
+    template <class V>
+    void visit_state(V&& v) {
+      v(filter);
+    }
   };
   std::size_t n_inputs_ = 0;
   std::size_t n_outputs_ = 0;
@@ -48,6 +57,11 @@ class ResidualGenerator {
   // A NaN in u makes the affected outputs' residuals NaN at k; the model
   // holds the last good input value for that input (zero-order hold).
   void step(const double* u, const double* y, double* residual) noexcept;
+  // Calls v(member) for every member that changes after setup (checkpoint).
+  template <class V>
+  void visit_state(V&& v) {
+    v(u0_); v(du_); v(y_model_); v(last_good_u_); v(model_);
+  }
 
  private:
   MimoModel model_;

@@ -118,18 +118,12 @@ class NestedRls {
   // Back to the prior.
   void reset() noexcept;
 
-  // Every member that changes after setup (for checkpointing).
+  // Calls v(member) for every member that changes after setup, in a fixed
+  // order: what a checkpoint saves and restores (daemon/mpmd/checkpoint.hpp).
   template <class V>
   void visit_state(V&& v) {
-    v(since_prior_);
-    v(next_prior_row_);
-    v(top_);
-    v(top_d_);
-    if (wald_) lower_wald_.visit_state(v);
-    else lower_.visit_state(v);
-    for (UdRls& p : pairs_) p.visit_state(v);
-    v(apriori_);
-    v(apriori_weight_);
+    v(since_prior_); v(next_prior_row_); v(top_); v(top_d_); v(lower_); v(lower_wald_); v(pairs_);
+    v(row_); v(row_weight_); v(apriori_); v(apriori_weight_);
   }
 
  private:

@@ -56,6 +56,11 @@ class DiscreteFilter {
   // for a stable filter; zero output history for an integrating one).
   void reset(double u_rest = 0.0) noexcept;
   const DiscreteTf& tf() const noexcept { return tf_; }
+  // Calls v(member) for every member that changes after setup (checkpoint).
+  template <class V>
+  void visit_state(V&& v) {
+    v(u_hist_); v(y_hist_); v(u_head_); v(y_head_);
+  }
 
  private:
   DiscreteTf tf_;

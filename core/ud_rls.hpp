@@ -68,16 +68,11 @@ class UdRls {
   const Eigen::VectorXd& weights() const noexcept { return d_; }
   void reset() noexcept;
 
-  // Every member that changes after setup (for checkpointing).
+  // Calls v(member) for every member that changes after setup, in a fixed
+  // order: what a checkpoint saves and restores (daemon/mpmd/checkpoint.hpp).
   template <class V>
   void visit_state(V&& v) {
-    v(since_prior_);
-    v(next_prior_row_);
-    v(u_);
-    v(d_);
-    v(changes_);
-    v(rss_stamp_);
-    v(rss_tail_);
+    v(since_prior_); v(next_prior_row_); v(u_); v(d_); v(work_); v(work_weight_); v(changes_); v(rss_stamp_); v(rss_tail_);
   }
 
  private:

@@ -18,9 +18,10 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: mpm listen (--transport lcm|dds | --config mpmd.yaml) [options]\n"
-    "  Prints alarms and status messages, one JSON object per line, until interrupted.\n"
+    "  Prints alarms, diagnoses and status messages, one JSON object per line, until interrupted.\n"
     "options:\n"
-    "  --alarms-only         no status lines\n"
+    "  --alarms-only         no status lines (and no diagnoses unless --diagnoses)\n"
+    "  --diagnoses           print the diagnoses that follow raised alarms (default without --alarms-only)\n"
     "  --samples             print controller samples too\n"
     "  --controller ID       only messages of this controller\n"
     "  --count N             exit after N lines (exit 1 if the timeout comes first)\n"
@@ -46,7 +47,12 @@ struct Filter {
   bool done() const { return count > 0 && printed >= count; }
 };
 
-int listen(transport::Transport& t, Filter& filter, bool samples, double timeout_s) {
+int listen(transport::Transport& t, Filter& filter, bool samples, bool diagnoses, double timeout_s) {
+  if (diagnoses || !filter.alarms_only) {
+    t.subscribe_diagnoses([&](const msg::Diagnosis& d) {
+      if (filter.wants(d.controller_id)) filter.print(msg::to_json(d));
+    });
+  }
   t.subscribe_alarms([&](const msg::Alarm& a) {
     if (filter.wants(a.controller_id)) filter.print(msg::to_json(a));
   });
@@ -75,10 +81,11 @@ int run(int argc, char** argv) {
   net_cli::NetOptions net;
   Filter filter;
   bool samples = false;
+  bool diagnoses = false;
   double timeout_s = 0;
   try {
     const Args args(argc, argv, net_cli::valued_options({"controller", "count", "timeout"}),
-                    {"alarms-only", "samples", "help"});
+                    {"alarms-only", "samples", "diagnoses", "help"});
     if (args.flag("help")) {
       std::printf("%s%s", kUsage, net_cli::kOptionsHelp);
       return 0;
@@ -88,6 +95,7 @@ int run(int argc, char** argv) {
     filter.alarms_only = args.flag("alarms-only");
     filter.count = args.integer("count", 0);
     samples = args.flag("samples");
+    diagnoses = args.flag("diagnoses");
     timeout_s = args.number("timeout", 0);
     if (filter.count < 0 || timeout_s < 0) throw UsageError("--count and --timeout must not be negative");
   } catch (const UsageError& e) {
@@ -105,7 +113,7 @@ int run(int argc, char** argv) {
   }
   signal(SIGINT, on_stop);
   signal(SIGTERM, on_stop);
-  return listen(*t, filter, samples, timeout_s);
+  return listen(*t, filter, samples, diagnoses, timeout_s);
 }
 
 const bool registered =

@@ -215,3 +215,49 @@ void from_wire(const mpm_dds_Status& in, msg::Status& out) {
 }
 
 }  // namespace mpm::transport::dds_codec
+
+namespace mpm::transport::dds_codec {
+
+void to_wire(const msg::Diagnosis& in, mpm_dds_Diagnosis& out, Scratch& scratch) {
+  out.controller_id = view(in.controller_id);
+  out.output = view(in.output);
+  out.input = view(in.input);
+  out.utime = in.utime;
+  out.sample_sequence = in.sample_sequence;
+  out.output_index = in.output_index;
+  out.input_index = in.input_index;
+  out.window = in.window;
+  out.found = in.found;
+  out.physics = view(in.physics);
+  out.channels = view(in.channels);
+  const std::size_t n = std::min(in.parameter_names.size(), in.parameter_values.size());
+  scratch.extra.resize(n);
+  for (std::size_t i = 0; i < n; ++i) scratch.extra[i] = {view(in.parameter_names[i]), in.parameter_values[i]};
+  out.parameters = view_of<dds_sequence_mpm_dds_NamedValue>(scratch.extra);
+  out.holdout_improvement = in.holdout_improvement;
+  out.text = view(in.text);
+}
+
+void from_wire(const mpm_dds_Diagnosis& in, msg::Diagnosis& out) {
+  assign(out.controller_id, in.controller_id);
+  assign(out.output, in.output);
+  assign(out.input, in.input);
+  out.utime = in.utime;
+  out.sample_sequence = in.sample_sequence;
+  out.output_index = in.output_index;
+  out.input_index = in.input_index;
+  out.window = in.window;
+  out.found = in.found;
+  assign(out.physics, in.physics);
+  assign(out.channels, in.channels);
+  out.parameter_names.resize(in.parameters._length);
+  out.parameter_values.resize(in.parameters._length);
+  for (std::uint32_t i = 0; i < in.parameters._length; ++i) {
+    assign(out.parameter_names[i], in.parameters._buffer[i].name);
+    out.parameter_values[i] = in.parameters._buffer[i].value;
+  }
+  out.holdout_improvement = in.holdout_improvement;
+  assign(out.text, in.text);
+}
+
+}  // namespace mpm::transport::dds_codec

@@ -36,5 +36,7 @@ WireError from_wire(const mpm_dds_Sample& in, const SampleLimits& limits, msg::S
 void from_wire(const mpm_dds_Sample& in, msg::Sample& out);
 void from_wire(const mpm_dds_Alarm& in, msg::Alarm& out);
 void from_wire(const mpm_dds_Status& in, msg::Status& out);
+void to_wire(const msg::Diagnosis& in, mpm_dds_Diagnosis& out, Scratch& scratch);
+void from_wire(const mpm_dds_Diagnosis& in, msg::Diagnosis& out);
 
 }  // namespace mpm::transport::dds_codec

@@ -118,6 +118,13 @@ class DdsTransport final : public Transport {
     on_status_ = std::move(handler);
     return true;
   }
+  // Diagnoses travel with the alarms' QoS (reliable, transient-local).
+  bool subscribe_diagnoses(DiagnosisHandler handler) override {
+    const QosHolder qos(dds_qos::alarm_reader());
+    if (!add_reader(diagnosis_topic(), qos.get(), diagnosis_reader_)) return false;
+    on_diagnosis_ = std::move(handler);
+    return true;
+  }
 
   bool advertise(Topic topic) override {
     std::lock_guard lock(publish_mutex_);
@@ -148,6 +155,14 @@ class DdsTransport final : public Transport {
     dds_codec::to_wire(status, wire, scratch_);
     return dds_write(w, &wire) == DDS_RETCODE_OK;
   }
+  bool publish(const msg::Diagnosis& diagnosis) override {
+    std::lock_guard lock(publish_mutex_);
+    const dds_entity_t w = writer(Topic::kDiagnosis);
+    if (w <= 0) return false;
+    mpm_dds_Diagnosis wire{};
+    dds_codec::to_wire(diagnosis, wire, scratch_);
+    return dds_write(w, &wire) == DDS_RETCODE_OK;
+  }
 
   int handle(std::chrono::milliseconds timeout) override {
     const dds_return_t rc = dds_waitset_wait(waitset_, nullptr, 0, DDS_MSECS(timeout.count()));
@@ -157,6 +172,7 @@ class DdsTransport final : public Transport {
     if (sample_reader_ > 0) handled += take<mpm_dds_Sample>(sample_reader_, sample_, on_sample_);
     if (alarm_reader_ > 0) handled += take<mpm_dds_Alarm>(alarm_reader_, alarm_, on_alarm_);
     if (status_reader_ > 0) handled += take<mpm_dds_Status>(status_reader_, status_, on_status_);
+    if (diagnosis_reader_ > 0) handled += take<mpm_dds_Diagnosis>(diagnosis_reader_, diagnosis_, on_diagnosis_);
     return handled;
   }
 
@@ -182,7 +198,7 @@ class DdsTransport final : public Transport {
   bool flush(std::chrono::milliseconds timeout) override {
     std::lock_guard lock(publish_mutex_);
     bool ok = true;
-    for (const dds_entity_t w : {sample_writer_, alarm_writer_, status_writer_}) {
+    for (const dds_entity_t w : {sample_writer_, alarm_writer_, status_writer_, diagnosis_writer_}) {
       if (w > 0) ok = dds_wait_for_acks(w, DDS_MSECS(timeout.count())) == DDS_RETCODE_OK && ok;
     }
     return ok;
@@ -210,6 +226,9 @@ class DdsTransport final : public Transport {
   dds_entity_t sample_topic() { return topic(sample_topic_, &mpm_dds_Sample_desc, settings_.sample_topic); }
   dds_entity_t alarm_topic() { return topic(alarm_topic_, &mpm_dds_Alarm_desc, settings_.alarm_topic); }
   dds_entity_t status_topic() { return topic(status_topic_, &mpm_dds_Status_desc, settings_.status_topic); }
+  dds_entity_t diagnosis_topic() {
+    return topic(diagnosis_topic_, &mpm_dds_Diagnosis_desc, settings_.diagnosis_topic);
+  }
 
   bool add_reader(dds_entity_t topic, const dds_qos_t* qos, dds_entity_t& reader) {
     if (topic <= 0 || reader > 0) return false;
@@ -241,6 +260,11 @@ class DdsTransport final : public Transport {
         if (status_writer_ > 0) return status_writer_;
         const QosHolder qos(dds_qos::status_writer());
         return status_writer_ = make_writer(status_topic(), qos.get());
+      }
+      case Topic::kDiagnosis: {
+        if (diagnosis_writer_ > 0) return diagnosis_writer_;
+        const QosHolder qos(dds_qos::alarm_writer());
+        return diagnosis_writer_ = make_writer(diagnosis_topic(), qos.get());
       }
     }
     return 0;
@@ -294,6 +318,9 @@ class DdsTransport final : public Transport {
   std::mutex topic_mutex_;
   dds_entity_t sample_topic_ = 0, alarm_topic_ = 0, status_topic_ = 0;
   dds_entity_t sample_reader_ = 0, alarm_reader_ = 0, status_reader_ = 0;
+  dds_entity_t diagnosis_topic_ = 0, diagnosis_reader_ = 0, diagnosis_writer_ = 0;
+  DiagnosisHandler on_diagnosis_;
+  msg::Diagnosis diagnosis_;
 
   SampleHandler on_sample_;
   AlarmHandler on_alarm_;

@@ -10,7 +10,7 @@
 namespace mpm::transport {
 
 namespace {
-using Message = std::variant<msg::Sample, msg::Alarm, msg::Status>;
+using Message = std::variant<msg::Sample, msg::Alarm, msg::Status, msg::Diagnosis>;
 constexpr int kMaxBatch = 256;
 }  // namespace
 
@@ -23,6 +23,7 @@ class FakeBus {
     bool samples = false;
     bool alarms = false;
     bool status = false;
+    bool diagnoses = false;
   };
 
   std::shared_ptr<Inbox> attach() {
@@ -67,6 +68,7 @@ class FakeBus {
   static bool wants(const Inbox& inbox, const Message& message) {
     if (std::holds_alternative<msg::Sample>(message)) return inbox.samples;
     if (std::holds_alternative<msg::Alarm>(message)) return inbox.alarms;
+    if (std::holds_alternative<msg::Diagnosis>(message)) return inbox.diagnoses;
     return inbox.status;
   }
 
@@ -97,10 +99,16 @@ class FakeTransport final : public Transport {
     bus_->with_lock([&] { inbox_->status = true; });
     return true;
   }
+  bool subscribe_diagnoses(DiagnosisHandler handler) override {
+    on_diagnosis_ = std::move(handler);
+    bus_->with_lock([&] { inbox_->diagnoses = true; });
+    return true;
+  }
 
   bool publish(const msg::Sample& sample) override { return deliver(sample); }
   bool publish(const msg::Alarm& alarm) override { return deliver(alarm); }
   bool publish(const msg::Status& status) override { return deliver(status); }
+  bool publish(const msg::Diagnosis& diagnosis) override { return deliver(diagnosis); }
 
   int handle(std::chrono::milliseconds timeout) override {
     batch_.clear();
@@ -127,6 +135,8 @@ class FakeTransport final : public Transport {
       if (on_alarm_) on_alarm_(*a);
     } else if (const auto* st = std::get_if<msg::Status>(&message)) {
       if (on_status_) on_status_(*st);
+    } else if (const auto* d = std::get_if<msg::Diagnosis>(&message)) {
+      if (on_diagnosis_) on_diagnosis_(*d);
     }
   }
 
@@ -136,6 +146,7 @@ class FakeTransport final : public Transport {
   SampleHandler on_sample_;
   AlarmHandler on_alarm_;
   StatusHandler on_status_;
+  DiagnosisHandler on_diagnosis_;
 };
 
 }  // namespace

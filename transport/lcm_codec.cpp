@@ -146,3 +146,46 @@ bool from_wire(const mpm_lcm::status_t& in, msg::Status& out) {
 }
 
 }  // namespace mpm::transport::lcm_codec
+
+namespace mpm::transport::lcm_codec {
+namespace {
+
+template <typename From, typename To>
+void copy_diagnosis_scalars(const From& in, To& out) {
+  out.controller_id = in.controller_id;
+  out.utime = in.utime;
+  out.sample_sequence = in.sample_sequence;
+  out.output = in.output;
+  out.input = in.input;
+  out.output_index = in.output_index;
+  out.input_index = in.input_index;
+  out.window = in.window;
+  out.found = in.found;
+  out.physics = in.physics;
+  out.channels = in.channels;
+  out.holdout_improvement = in.holdout_improvement;
+  out.text = in.text;
+}
+
+}  // namespace
+
+void to_wire(const msg::Diagnosis& in, mpm_lcm::diagnosis_t& out) {
+  copy_diagnosis_scalars(in, out);
+  const std::size_t n = std::min(in.parameter_names.size(), in.parameter_values.size());
+  out.parameter_names.assign(in.parameter_names.begin(), in.parameter_names.begin() + static_cast<std::ptrdiff_t>(n));
+  out.parameter_values.assign(in.parameter_values.begin(), in.parameter_values.begin() + static_cast<std::ptrdiff_t>(n));
+  out.n_parameters = static_cast<std::int32_t>(n);
+}
+
+bool from_wire(const mpm_lcm::diagnosis_t& in, msg::Diagnosis& out) {
+  if (in.n_parameters < 0 || in.parameter_names.size() != static_cast<std::size_t>(in.n_parameters) ||
+      in.parameter_values.size() != static_cast<std::size_t>(in.n_parameters)) {
+    return false;
+  }
+  copy_diagnosis_scalars(in, out);
+  out.parameter_names.assign(in.parameter_names.begin(), in.parameter_names.end());
+  out.parameter_values.assign(in.parameter_values.begin(), in.parameter_values.end());
+  return true;
+}
+
+}  // namespace mpm::transport::lcm_codec

@@ -56,6 +56,10 @@ class LcmTransport final : public Transport {
     on_status_ = std::move(handler);
     return subscribe(settings_.status_channel, routes_[2], &LcmTransport::receive_status);
   }
+  bool subscribe_diagnoses(DiagnosisHandler handler) override {
+    on_diagnosis_ = std::move(handler);
+    return subscribe(settings_.diagnosis_channel, routes_[3], &LcmTransport::receive_diagnosis);
+  }
 
   bool publish(const msg::Sample& sample) override {
     std::lock_guard lock(publish_mutex_);
@@ -71,6 +75,11 @@ class LcmTransport final : public Transport {
     std::lock_guard lock(publish_mutex_);
     lcm_codec::to_wire(status, tx_status_);
     return send(settings_.status_channel, tx_status_);
+  }
+  bool publish(const msg::Diagnosis& diagnosis) override {
+    std::lock_guard lock(publish_mutex_);
+    lcm_codec::to_wire(diagnosis, tx_diagnosis_);
+    return send(settings_.diagnosis_channel, tx_diagnosis_);
   }
 
   // lcm's handleTimeout dispatches one message; drain what is already waiting
@@ -173,14 +182,23 @@ class LcmTransport final : public Transport {
     rx_status_.loops.clear();
     receive(rbuf, checked, rx_status_, status_, on_status_);
   }
+  void receive_diagnosis(const lcm_recv_buf_t* rbuf) {
+    const SampleLimits limits = sample_limits();
+    const auto checked = check_lcm_diagnosis(rbuf->data, rbuf->data_size, limits.max_string, kMaxStatusItems);
+    rx_diagnosis_ = {};  // fresh each time: LCM 1.3 does not clear zero-length arrays
+    receive(rbuf, checked, rx_diagnosis_, diagnosis_, on_diagnosis_);
+  }
 
   LcmSettings settings_;
   lcm_t* lcm_;
-  Route routes_[3];  // samples, alarms, status: addresses handed to LCM
+  Route routes_[4];  // samples, alarms, status, diagnoses: addresses handed to LCM
 
   SampleHandler on_sample_;
   AlarmHandler on_alarm_;
   StatusHandler on_status_;
+  DiagnosisHandler on_diagnosis_;
+  mpm_lcm::diagnosis_t rx_diagnosis_;
+  msg::Diagnosis diagnosis_;
   mpm_lcm::alarm_t rx_alarm_;
   mpm_lcm::status_t rx_status_;
   msg::Sample sample_;
@@ -192,6 +210,7 @@ class LcmTransport final : public Transport {
   mpm_lcm::sample_t tx_sample_;
   mpm_lcm::alarm_t tx_alarm_;
   mpm_lcm::status_t tx_status_;
+  mpm_lcm::diagnosis_t tx_diagnosis_;
   std::vector<std::uint8_t> tx_buffer_;
 };
 

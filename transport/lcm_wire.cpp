@@ -5,6 +5,7 @@
 // Only for the types' fingerprints: the generated decoders are not used on
 // received bytes (see the header).
 #include <mpm_lcm/alarm_t.hpp>
+#include <mpm_lcm/diagnosis_t.hpp>
 #include <mpm_lcm/sample_t.hpp>
 #include <mpm_lcm/status_t.hpp>
 
@@ -215,6 +216,27 @@ WireError check_lcm_status(const void* data, std::size_t size, std::uint32_t max
     MPM_WIRE_TRY(r.skip_string(max_string));
     MPM_WIRE_TRY(need(r.skip(3 * 8 + 2)));
   }
+  return r.left() == 0 ? WireError::kNone : WireError::kTrailingBytes;
+}
+
+WireError check_lcm_diagnosis(const void* data, std::size_t size, std::uint32_t max_string,
+                              std::uint32_t max_items) noexcept {
+  Reader r(data, size);
+  MPM_WIRE_TRY(fingerprint(r, mpm_lcm::diagnosis_t::getHash()));
+  MPM_WIRE_TRY(r.skip_string(max_string));                       // controller_id
+  MPM_WIRE_TRY(need(r.skip(2 * 8)));                             // utime, sample_sequence
+  MPM_WIRE_TRY(r.skip_string(max_string));                       // output
+  MPM_WIRE_TRY(r.skip_string(max_string));                       // input
+  MPM_WIRE_TRY(need(r.skip(3 * 4 + 1)));                         // indices, window, found
+  MPM_WIRE_TRY(r.skip_string(max_string));                       // physics
+  MPM_WIRE_TRY(r.skip_string(max_string * 4));                   // channels
+  std::int32_t n = 0;
+  MPM_WIRE_TRY(r.count(n, (4 + 1) + 8));                         // a name and a value each
+  if (static_cast<std::uint32_t>(n) > max_items) return WireError::kTooManyExtras;
+  for (std::int32_t i = 0; i < n; ++i) MPM_WIRE_TRY(r.skip_string(max_string));
+  MPM_WIRE_TRY(need(r.skip(static_cast<std::size_t>(n) * 8)));  // parameter_values
+  MPM_WIRE_TRY(need(r.skip(8)));                                 // holdout_improvement
+  MPM_WIRE_TRY(r.skip_string(max_string * 4));                   // text
   return r.left() == 0 ? WireError::kNone : WireError::kTrailingBytes;
 }
 

@@ -55,5 +55,7 @@ WireError decode_lcm_sample(const void* data, std::size_t size, const SampleLimi
 WireError check_lcm_alarm(const void* data, std::size_t size, std::uint32_t max_string) noexcept;
 WireError check_lcm_status(const void* data, std::size_t size, std::uint32_t max_string,
                            std::uint32_t max_items) noexcept;
+WireError check_lcm_diagnosis(const void* data, std::size_t size, std::uint32_t max_string,
+                              std::uint32_t max_items) noexcept;
 
 }  // namespace mpm::transport

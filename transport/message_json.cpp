@@ -126,6 +126,32 @@ std::string to_json(const Alarm& a) {
       .str();
 }
 
+std::string to_json(const Diagnosis& d) {
+  std::string parameters = "{";
+  for (std::size_t i = 0; i < d.parameter_names.size() && i < d.parameter_values.size(); ++i) {
+    if (i) parameters += ',';
+    // One-field object, its braces dropped: a name-value pair with our escaping.
+    const std::string pair = JsonObject().field(d.parameter_names[i].c_str(), d.parameter_values[i]).str();
+    parameters += pair.substr(1, pair.size() - 2);
+  }
+  parameters += '}';
+  return JsonObject()
+      .field("type", "diagnosis")
+      .field("controller", d.controller_id)
+      .field("utime", d.utime)
+      .field("sample_sequence", d.sample_sequence)
+      .field("output", d.output)
+      .field("input", d.input)
+      .field("window", d.window)
+      .field("found", d.found)
+      .field("physics", d.physics)
+      .field("channels", d.channels)
+      .raw("parameters", parameters)
+      .field("holdout_improvement", d.holdout_improvement)
+      .field("text", d.text)
+      .str();
+}
+
 std::string to_json(const Status& s) {
   const std::string channels = array_of(s.channels, [](const ChannelStatus& c) {
     return JsonObject()

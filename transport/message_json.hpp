@@ -11,5 +11,6 @@ namespace mpm::msg {
 std::string to_json(const Alarm& alarm);
 std::string to_json(const Status& status);
 std::string to_json(const Sample& sample);
+std::string to_json(const Diagnosis& diagnosis);
 
 }  // namespace mpm::msg

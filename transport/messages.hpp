@@ -41,6 +41,25 @@ struct Alarm {
   std::string text;
 };
 
+// The offline diagnosis of a raised output (transport/README.md).
+struct Diagnosis {
+  std::string controller_id;
+  std::int64_t utime = 0;
+  std::int64_t sample_sequence = 0;
+  std::string output;
+  std::string input;
+  std::int32_t output_index = 0;
+  std::int32_t input_index = 0;
+  std::int32_t window = 0;
+  bool found = false;
+  std::string physics;   // "" when nothing was found
+  std::string channels;
+  std::vector<std::string> parameter_names;
+  std::vector<double> parameter_values;
+  double holdout_improvement = 0.0;
+  std::string text;
+};
+
 struct ChannelStatus {
   std::string output;
   std::string input;

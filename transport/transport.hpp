@@ -39,6 +39,17 @@ class Transport {
   virtual bool publish(const msg::Sample& sample) = 0;
   virtual bool publish(const msg::Alarm& alarm) = 0;
   virtual bool publish(const msg::Status& status) = 0;
+  // Diagnoses (added later than the three above; a transport without them
+  // refuses).
+  using DiagnosisHandler = std::function<void(const msg::Diagnosis&)>;
+  virtual bool subscribe_diagnoses(DiagnosisHandler handler) {
+    (void)handler;
+    return false;
+  }
+  virtual bool publish(const msg::Diagnosis& diagnosis) {
+    (void)diagnosis;
+    return false;
+  }
 
   // Waits up to `timeout` for messages and dispatches what arrived (a bounded
   // batch) to the handlers. Returns the number dispatched, 0 on timeout, -1
@@ -53,7 +64,7 @@ class Transport {
 
   // Creates the publisher of one kind ahead of the first publish(), so that
   // discovery (DDS) is under way by then. A no-op where there is none.
-  enum class Topic { kSample, kAlarm, kStatus };
+  enum class Topic { kSample, kAlarm, kStatus, kDiagnosis };
   virtual bool advertise(Topic topic) {
     (void)topic;
     return true;

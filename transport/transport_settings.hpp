@@ -15,6 +15,7 @@ struct LcmSettings {
   std::string sample_channel = "MPM_SAMPLE";
   std::string alarm_channel = "MPM_ALARM";
   std::string status_channel = "MPM_STATUS";
+  std::string diagnosis_channel = "MPM_DIAGNOSIS";
 };
 
 struct DdsSettings {
@@ -25,6 +26,7 @@ struct DdsSettings {
   std::string sample_topic = "mpm_sample";
   std::string alarm_topic = "mpm_alarm";
   std::string status_topic = "mpm_status";
+  std::string diagnosis_topic = "mpm_diagnosis";
   int sample_history = 64;  // KEEP_LAST depth of sample writer and reader
 };
 

@@ -114,6 +114,12 @@ int main(int argc, char** argv) {
                 loaded->config.controller_id.c_str(), loaded->config.plant_path.c_str());
     return 0;
   }
+  // The state of the previous run, when it fits this plant and these settings.
+  const bool resumed = resume_from_checkpoint(service, *loaded, error);
+  if (!service) {
+    log::write(log::Level::kError, "%s", error.c_str());
+    return 1;
+  }
 
   // 3. Transport, the bounded queue and the receiver thread.
   // Every received sample is checked against the plant's dimensions before
@@ -128,6 +134,8 @@ int main(int argc, char** argv) {
   }
   transport->advertise(transport::Transport::Topic::kAlarm);
   transport->advertise(transport::Transport::Topic::kStatus);
+  transport->advertise(transport::Transport::Topic::kDiagnosis);
+  if (resumed) service->republish_raised("the service restarted and resumed from its checkpoint");
   SampleQueue queue(static_cast<std::size_t>(loaded->config.queue_capacity));
   Receiver receiver(*transport, queue);
   if (!receiver.start(error)) {

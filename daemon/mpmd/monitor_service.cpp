@@ -65,7 +65,11 @@ MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& s
       residual_(plant.n_outputs(), 0.0),
       nan_u_(plant.n_inputs(), kNaN),
       nan_y_(plant.n_outputs(), kNaN),
-      alarm_state_(plant.n_inputs() * plant.n_outputs(), 0) {
+      alarm_state_(plant.n_inputs() * plant.n_outputs(), 0),
+      physics_(plant.n_inputs() * plant.n_outputs()) {
+  if (settings.diagnosis_window > 0) {
+    diagnosis_ = std::make_unique<DiagnosisWorker>(plant, static_cast<std::size_t>(settings.diagnosis_window));
+  }
   settle_ = settings.settle_samples >= 0 ? settings.settle_samples
                                          : static_cast<int>(settling_samples(plant, 0.01, kSettleCap));
   settling_ = settle_;
@@ -159,8 +163,10 @@ void MonitorService::step(const double* u, const double* y, const double* sim_y)
   }
   if (settling_ > 0) {
     --settling_;
+    if (diagnosis_) diagnosis_->record(u, nan_y_.data());  // the transient is not evidence
     return;
   }
+  if (diagnosis_) diagnosis_->record(u, residual_.data());
   monitor_.update(u, residual_.data());
 }
 
@@ -171,7 +177,9 @@ void MonitorService::check_alarms(const msg::Sample& s) {
       const std::uint8_t now = monitor_.channel(j, i).alarm ? 1 : 0;
       if (now == alarm_state_[j * n_in + i]) continue;
       alarm_state_[j * n_in + i] = now;
+      if (now) physics_[j * n_in + i].clear();  // a new episode: its physics is not known yet
       publish_alarm(j, i, s);
+      if (now && diagnosis_) diagnosis_->request({j, i, alarm_.utime, s.seq, settings_.controller_id});
     }
   }
 }
@@ -185,6 +193,26 @@ void MonitorService::fill_alarm_header(std::size_t output, std::size_t input, st
   alarm_.input = plant_.inputs[input];
   alarm_.output_index = static_cast<std::int32_t>(output);
   alarm_.input_index = static_cast<std::int32_t>(input);
+}
+
+void MonitorService::republish_raised(const std::string& reason) {
+  const std::size_t n_in = plant_.n_inputs();
+  for (std::size_t j = 0; j < plant_.n_outputs(); ++j) {
+    for (std::size_t i = 0; i < n_in; ++i) {
+      if (!alarm_state_[j * n_in + i]) continue;
+      const ChannelStats& c = monitor_.channel(j, i);
+      fill_alarm_header(j, i, 0, tracker_.last());
+      alarm_.raised = true;
+      alarm_.f = c.f_conditional;
+      alarm_.p_value = monitor_.p_value(c.lr_conditional);
+      alarm_.gamma = c.gamma;
+      alarm_.physics = physics_[j * n_in + i];
+      alarm_.text = "still raised: model-plant mismatch on " + alarm_.input + " -> " + alarm_.output + " (" +
+                    reason + ")";
+      log::write(log::Level::kWarning, "controller '%s': %s", settings_.controller_id.c_str(), alarm_.text.c_str());
+      if (on_alarm_) on_alarm_(alarm_);
+    }
+  }
 }
 
 void MonitorService::retire(const std::string& reason) {
@@ -215,7 +243,9 @@ void MonitorService::publish_alarm(std::size_t output, std::size_t input, const 
   alarm_.f = c.f_conditional;
   alarm_.p_value = monitor_.p_value(c.lr_conditional);
   alarm_.gamma = c.gamma;
-  alarm_.physics.clear();  // the online monitor locates; naming physics is the offline diagnosis' job
+  // Known once the diagnosis that a raise asks for has finished: empty in the
+  // raise itself (the diagnosis message follows it), filled in later alarms.
+  alarm_.physics = physics_[output * plant_.n_inputs() + input];
   char text[256];
   const LoopStats& l = monitor_.loop(output);
   if (c.alarm) {

@@ -20,6 +20,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +28,7 @@
 #include "core/granger_monitor.hpp"
 #include "core/mimo_model.hpp"
 #include "core/plant_model.hpp"
+#include "daemon/mpmd/diagnosis_worker.hpp"
 #include "daemon/mpmd/sequence_tracker.hpp"
 #include "daemon/mpmd/throttle.hpp"
 #include "transport/messages.hpp"
@@ -49,6 +51,9 @@ struct ServiceSettings {
   // Seconds without a usable sample after which the status says not ready;
   // -1 = automatic (the longer of 60 s and 10 sample times), 0 = never.
   double stale_after = -1.0;
+  // Samples kept for the diagnosis of a raised output (diagnosis_worker.hpp);
+  // 0 = no diagnosis.
+  int diagnosis_window = 0;
 };
 
 struct ServiceCounters {
@@ -63,6 +68,11 @@ struct ServiceCounters {
   std::uint64_t nan_samples = 0;
   std::uint64_t dropped = 0;       // lost before the service (receive queue full)
   std::uint64_t foreign = 0;       // samples of other controllers, ignored
+  template <class V>
+  void visit_state(V&& v) {  // checkpoint
+    v(seen); v(gaps); v(missing); v(duplicates); v(out_of_order); v(restarts); v(malformed); v(nan_samples);
+    v(dropped); v(foreign);
+  }
 };
 
 class MonitorService {
@@ -101,7 +111,42 @@ class MonitorService {
   const PlantModel& plant() const noexcept { return plant_; }
   const ServiceSettings& settings() const noexcept { return settings_; }
   int settle_samples() const noexcept { return settle_; }
+  std::int64_t last_sequence() const noexcept { return tracker_.last(); }
   const AlarmSink& alarm_sink() const noexcept { return on_alarm_; }
+
+  // Main thread, between samples: hands over a pending diagnosis request and
+  // passes each finished diagnosis to `publish`; the physics it names goes
+  // into the channel's later alarm messages (the clear, a resume).
+  template <class Publish>
+  void poll_diagnoses(Publish&& publish) {
+    if (!diagnosis_) return;
+    while (diagnosis_->take(diagnosis_msg_)) {
+      if (diagnosis_msg_.found) physics_[static_cast<std::size_t>(diagnosis_msg_.output_index) * plant_.n_inputs() +
+                                         static_cast<std::size_t>(diagnosis_msg_.input_index)] = diagnosis_msg_.physics;
+      publish(diagnosis_msg_);
+    }
+  }
+  const DiagnosisWorker* diagnosis() const noexcept { return diagnosis_.get(); }
+
+  // Publishes a "raised" alarm again for every channel raised now, saying
+  // why (the service resumed from a checkpoint): listeners that saw the
+  // previous process die learn the alarm still stands.
+  void republish_raised(const std::string& reason);
+
+  // Calls v(member) for everything that changes after setup (checkpoint.hpp):
+  // the residual model (made at the first complete sample when the plant
+  // file gives no operating point), the sequence, counters, settling and
+  // alarm states, and the monitor. Throttles start afresh.
+  template <class V>
+  void visit_state(V&& v) {
+    bool has_residuals = residuals_.has_value();
+    v(has_residuals);
+    // On reading: a placeholder u0, overwritten by the residual model's own state.
+    if (has_residuals && !residuals_) residuals_.emplace(plant_, std::vector<double>(plant_.n_inputs(), 0.0));
+    if (!has_residuals) residuals_.reset();
+    if (residuals_) v(*residuals_);
+    v(tracker_); v(counters_); v(settling_); v(alarm_state_); v(monitor_);
+  }
 
  private:
   bool sized_right(const msg::Sample& s) const noexcept;
@@ -132,6 +177,9 @@ class MonitorService {
   std::vector<double> nan_u_, nan_y_;        // a missing sample
   std::vector<std::uint8_t> alarm_state_;    // output-major, as published
   msg::Alarm alarm_;
+  std::unique_ptr<DiagnosisWorker> diagnosis_;  // null when diagnosis_window = 0
+  std::vector<std::string> physics_;           // per channel: the last diagnosis' physics word
+  msg::Diagnosis diagnosis_msg_;
 
   struct Throttles {
     Throttle foreign, gap, duplicate, out_of_order, restart, jump, malformed, nan, dropped, receive_errors;

@@ -65,6 +65,10 @@ class SequenceTracker {
   }
 
   std::int64_t last() const noexcept { return last_; }
+  template <class V>
+  void visit_state(V&& v) {  // checkpoint
+    v(started_); v(session_); v(last_);
+  }
 
  private:
   Result accept(Result r, std::int64_t session_id, std::int64_t seq) noexcept {

@@ -40,6 +40,7 @@ class ServiceLoop {
   void publish_status(Clock::time_point now);
   void feed_watchdog(Clock::time_point now);
   void apply_reload();
+  void write_checkpoint(Clock::time_point now, bool final_one);
   void wait(Clock::time_point until);
 
   std::string config_path_;
@@ -56,6 +57,8 @@ class ServiceLoop {
   std::uint64_t dropped_seen_ = 0;
   std::uint64_t receive_errors_seen_ = 0;
   std::uint64_t status_failures_ = 0;
+  Clock::time_point next_checkpoint_;
+  Throttle checkpoint_failures_;
   msg::Status status_;
   Throttle reload_throttle_;
 };

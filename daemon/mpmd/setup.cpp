@@ -6,6 +6,7 @@
 
 #include "config/plant_loader.hpp"
 #include "core/mimo_model.hpp"
+#include "daemon/mpmd/checkpoint.hpp"
 #include "daemon/mpmd/log.hpp"
 
 namespace mpm {
@@ -61,12 +62,47 @@ std::unique_ptr<MonitorService> make_service(const LoadedConfig& loaded, Monitor
   settings.log_interval = loaded.config.log_interval;
   settings.max_sequence_jump = loaded.config.max_sequence_jump;
   settings.stale_after = loaded.config.stale_after;
+  settings.diagnosis_window = loaded.config.diagnosis_window;
   try {
     return std::make_unique<MonitorService>(loaded.plant, settings, std::move(on_alarm));
   } catch (const std::exception& e) {
     error = loaded.config.source + ": monitor: " + e.what();
     return nullptr;
   }
+}
+
+std::uint64_t checkpoint_fingerprint(const LoadedConfig& loaded) {
+  return checkpoint::fnv1a(loaded.monitor_fingerprint.data(), loaded.monitor_fingerprint.size());
+}
+
+bool resume_from_checkpoint(std::unique_ptr<MonitorService>& service, const LoadedConfig& loaded,
+                            std::string& error) {
+  const std::string& path = loaded.config.checkpoint_path;
+  if (path.empty()) return false;
+  std::string why;
+  switch (checkpoint::load(*service, path, checkpoint_fingerprint(loaded), why)) {
+    case checkpoint::Outcome::kResumed: {
+      const ServiceCounters& c = service->counters();
+      log::write(log::Level::kNotice,
+                 "resumed from checkpoint %s: %llu samples seen, %llu used, last sample %lld", path.c_str(),
+                 static_cast<unsigned long long>(c.seen),
+                 static_cast<unsigned long long>(service->monitor().counters().used),
+                 static_cast<long long>(service->last_sequence()));
+      return true;
+    }
+    case checkpoint::Outcome::kAbsent:
+      log::write(log::Level::kNotice, "%s: starting fresh", why.c_str());
+      return false;
+    case checkpoint::Outcome::kOtherSetup:
+      log::write(log::Level::kNotice, "checkpoint %s: starting fresh (it will be replaced)", why.c_str());
+      return false;
+    case checkpoint::Outcome::kRefused:
+      break;
+  }
+  log::write(log::Level::kWarning, "checkpoint %s: refused, starting fresh (it will be replaced)", why.c_str());
+  service = make_service(loaded, service->alarm_sink(), error);
+  if (!service) return false;
+  return false;
 }
 
 MonitorService::AlarmSink publish_to(const std::unique_ptr<transport::Transport>& transport) {

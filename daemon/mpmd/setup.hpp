@@ -2,6 +2,7 @@
 // the sequence it is: configuration -> monitor -> transport -> ready.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -29,6 +30,16 @@ std::optional<LoadedConfig> load_config(const std::string& path, std::string& er
 // when the settings do not fit the plant.
 std::unique_ptr<MonitorService> make_service(const LoadedConfig& loaded, MonitorService::AlarmSink on_alarm,
                                              std::string& error);
+
+// Loads the configured checkpoint (checkpoint.hpp) into `*service` when it
+// was written for this plant and these settings, else leaves the service
+// fresh (rebuilt when a refused file had partly overwritten it); logs which
+// and why. True when it resumed. False with `error` set only when the
+// service could not be rebuilt.
+bool resume_from_checkpoint(std::unique_ptr<MonitorService>& service, const LoadedConfig& loaded,
+                            std::string& error);
+// The checkpoint's fingerprint of a configuration (its monitor_fingerprint).
+std::uint64_t checkpoint_fingerprint(const LoadedConfig& loaded);
 
 // An alarm sink that publishes through `*transport` (once it is set) and
 // logs a failure to publish.

@@ -30,6 +30,11 @@ class Observer {
       ++status_count_[s.controller_id];
       changed_.notify_all();
     });
+    t.subscribe_diagnoses([this](const msg::Diagnosis& d) {
+      std::lock_guard lock(mutex_);
+      diagnoses_.push_back(d);
+      changed_.notify_all();
+    });
     thread_ = std::thread([this] {
       while (!stop_) transport_.handle(std::chrono::milliseconds(50));
     });
@@ -56,6 +61,10 @@ class Observer {
     std::lock_guard lock(mutex_);
     return alarms_;
   }
+  std::vector<msg::Diagnosis> diagnoses() const {
+    std::lock_guard lock(mutex_);
+    return diagnoses_;
+  }
 
   // Waits until `pred(status)` holds for the controller's latest status.
   template <typename Pred>
@@ -79,6 +88,7 @@ class Observer {
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   std::vector<msg::Alarm> alarms_;
+  std::vector<msg::Diagnosis> diagnoses_;
   std::map<std::string, msg::Status> status_;
   std::map<std::string, int> status_count_;
   std::atomic<bool> stop_{false};

@@ -2,7 +2,9 @@
 // by deploy/mpm-lcm-spy under Xvfb, wrapped by SpyProbe which prints what its
 // windows show) lists MPM_ALARM with our type and no undecodable message; a
 // double-click (xdotool) opens the decoded alarm, and a screenshot of it is
-// saved as <build>/Testing/lcm-spy-alarm.png for people to look at.
+// saved as <build>/Testing/lcm-spy-alarm.png for people to look at. The
+// diagnosis that follows the raise (diagnosis_t on MPM_DIAGNOSIS) is decoded
+// too, and its viewer saved as <build>/Testing/lcm-spy-diagnosis.png.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -20,6 +22,7 @@ namespace {
 const std::string kMpmd = MPM_BINARY_DIR "/daemon/mpmd/mpmd";
 const std::string kSpyScript = MPM_SOURCE_DIR "/deploy/mpm-lcm-spy";
 const std::string kScreenshot = MPM_BINARY_DIR "/Testing/lcm-spy-alarm.png";
+const std::string kDiagnosisScreenshot = MPM_BINARY_DIR "/Testing/lcm-spy-diagnosis.png";
 
 bool on_path(const std::string& tool) { return std::system(("command -v " + tool + " >/dev/null 2>&1").c_str()) == 0; }
 
@@ -115,7 +118,7 @@ TEST(LcmSpy, ShowsOurAlarmsDecoded) {
                     {"MPM_LCM_SPY_EXTRA_CLASSPATH", MPM_SPY_PROBE_JAR}});
   ASSERT_TRUE(eventually([&] { return row(spy.stdout_text(), "MPM_STATUS").has_value(); }, std::chrono::seconds(60)))
       << spy.stdout_text() << spy.stderr_text();
-  EXPECT_NE(spy.stdout_text().find("Found 5 LCM types"), std::string::npos) << "lcm-spy loaded our jar";
+  EXPECT_NE(spy.stdout_text().find("Found 6 LCM types"), std::string::npos) << "lcm-spy loaded our jar";
 
   // Alarms flow: the controller's plant drifts until mpmd raises.
   WoodBerryStream stream(3);
@@ -164,6 +167,30 @@ TEST(LcmSpy, ShowsOurAlarmsDecoded) {
            std::filesystem::file_size(kScreenshot) > 10000;
   }));
   std::printf("screenshot: %s\n", kScreenshot.c_str());
+
+  // The diagnosis that follows the raise: decoded as diagnosis_t.
+  ASSERT_TRUE(eventually([&] { return !obs.diagnoses().empty(); })) << mpmd.stderr_text();
+  ASSERT_TRUE(eventually([&] { return row(spy.stdout_text(), "MPM_DIAGNOSIS").has_value(); }))
+      << spy.stdout_text();
+  const Row diagnosis = *row(spy.stdout_text(), "MPM_DIAGNOSIS");
+  EXPECT_EQ(diagnosis.type, "diagnosis_t");
+  EXPECT_GE(diagnosis.messages, 1);
+  EXPECT_EQ(diagnosis.undecodable, 0);
+  // The alarm's viewer opened over the channel table (no window manager
+  // here): hide it so the double-click reaches the table.
+  std::system(("DISPLAY=" + display + " xdotool search --name '^MPM_ALARM$' windowunmap >/dev/null 2>&1").c_str());
+  const std::string open_diagnosis = "DISPLAY=" + display + " xdotool mousemove " + std::to_string(diagnosis.x) +
+                                     " " + std::to_string(diagnosis.y) + " click --repeat 2 --delay 100 1";
+  ASSERT_TRUE(eventually([&] {
+    if (std::system(open_diagnosis.c_str()) != 0) return false;
+    return eventually([&] { return viewer_open(spy.stdout_text(), "MPM_DIAGNOSIS"); }, std::chrono::seconds(3));
+  })) << spy.stdout_text();
+  std::filesystem::remove(kDiagnosisScreenshot);
+  ASSERT_TRUE(eventually([&] {
+    return std::system(("DISPLAY=" + display + " import -window root " + kDiagnosisScreenshot).c_str()) == 0 &&
+           std::filesystem::file_size(kDiagnosisScreenshot) > 10000;
+  }));
+  std::printf("screenshot: %s (%s)\n", kDiagnosisScreenshot.c_str(), obs.diagnoses().front().text.c_str());
 
   spy.signal(SIGTERM);
   spy.wait_exit(std::chrono::seconds(10));

@@ -1,0 +1,233 @@
+// mpmd killed with SIGKILL in the middle of a run and started again: it
+// resumes from its last checkpoint with statistics equal (to 1e-12 relative)
+// to those of an uninterrupted monitor fed the same samples up to that
+// checkpoint, the raised alarm still raised and said again; fed the rest of
+// the stream it ends where an uninterrupted run ends. A changed plant file
+// and a damaged checkpoint both start fresh, with a log line saying why.
+// Over LCM, as a separate process, in a private network namespace
+// (run_isolated.sh); the reference monitor is built in this process from the
+// same configuration file (daemon/mpmd/setup.hpp), as mpmd builds its own.
+#include <cmath>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+
+#include "daemon/mpmd/checkpoint.hpp"
+#include "daemon/mpmd/setup.hpp"
+#include "loopback_fixture.hpp"
+
+namespace mpm::test {
+namespace {
+
+double rel(double a, double b) {
+  if ((std::isnan(a) && std::isnan(b)) || a == b) return 0.0;
+  return std::abs(a - b) / std::max(std::abs(a), std::abs(b));
+}
+
+// Largest relative difference of the statistics; counters and flags must be equal.
+double compare(const msg::Status& a, const msg::Status& b) {
+  EXPECT_EQ(a.samples_seen, b.samples_seen);
+  EXPECT_EQ(a.samples_used, b.samples_used);
+  EXPECT_EQ(a.alarms_raised, b.alarms_raised);
+  EXPECT_EQ(a.ready, b.ready);
+  double worst = rel(a.effective_samples, b.effective_samples);
+  if (a.channels.size() != b.channels.size() || a.loops.size() != b.loops.size()) {
+    ADD_FAILURE() << "different shapes";
+    return 1.0;
+  }
+  for (std::size_t c = 0; c < a.channels.size(); ++c) {
+    const auto& x = a.channels[c];
+    const auto& y = b.channels[c];
+    EXPECT_EQ(x.alarm, y.alarm);
+    for (const auto& [p, q] : {std::pair{x.f_pairwise, y.f_pairwise}, {x.f_conditional, y.f_conditional},
+                               {x.lr, y.lr}, {x.gamma, y.gamma}}) {
+      worst = std::max(worst, rel(p, q));
+    }
+  }
+  for (std::size_t j = 0; j < a.loops.size(); ++j) {
+    EXPECT_EQ(a.loops[j].alarm, b.loops[j].alarm);
+    worst = std::max({worst, rel(a.loops[j].residual_variance, b.loops[j].residual_variance),
+                      rel(a.loops[j].sigma1, b.loops[j].sigma1), rel(a.loops[j].sigma_full, b.loops[j].sigma_full)});
+  }
+  return worst;
+}
+
+// The monitor mpmd builds from `config`, fed `samples[0, n)` in this process.
+msg::Status reference(const std::string& config, const std::vector<msg::Sample>& samples, std::size_t n) {
+  std::string error;
+  auto loaded = load_config(config, error);
+  EXPECT_TRUE(loaded) << error;
+  if (!loaded) return {};
+  auto service = make_service(*loaded, {}, error);
+  EXPECT_TRUE(service) << error;
+  if (!service) return {};
+  for (std::size_t k = 0; k < n && k < samples.size(); ++k) service->on_sample(samples[k], {});
+  msg::Status s;
+  service->fill_status(s, 0, 0);
+  return s;
+}
+
+class CheckpointTest : public LoopbackTest {
+ protected:
+  // mpmd.yaml with a checkpoint every 0.1 s; `plant` replaces the Wood-Berry file.
+  std::string config_with_checkpoint(const std::string& plant = "") const {
+    const std::string path = write_config("mpmd.yaml", "wb");
+    std::string text = ChildProcess::read(path);
+    if (!plant.empty()) {
+      const std::string from = MPM_SOURCE_DIR "/config/wood-berry.yaml";
+      text.replace(text.find(from), from.size(), plant);
+    }
+    dir().write("mpmd.yaml", text + "checkpoint_path: " + dir().file("mpmd.state") + "\ncheckpoint_interval: 0.1\n");
+    return path;
+  }
+
+  // Publishes `n` samples of `c` (synced), keeping a copy of each.
+  bool publish(transport::Transport& t, Observer& obs, Controller& c, int n, std::vector<msg::Sample>& sent) {
+    for (int k = 0; k < n; ++k) {
+      sent.push_back(c.next());
+      if (!t.publish(c.sample)) return false;
+      ++c.sent;
+      if ((k + 1) % 50 == 0 || k + 1 == n) {
+        const std::int64_t seq = c.seq;
+        if (!obs.wait_status(c.id, [seq](const msg::Status& s) { return s.samples_seen >= seq; })) return false;
+      }
+    }
+    return true;
+  }
+
+  // The samples seen by the last checkpoint on disk (0 when none can be read).
+  std::uint64_t checkpointed(const std::string& config) const {
+    std::string error, why;
+    auto loaded = load_config(config, error);
+    if (!loaded) return 0;
+    auto service = make_service(*loaded, {}, error);
+    if (!service) return 0;
+    if (checkpoint::load(*service, loaded->config.checkpoint_path, checkpoint_fingerprint(*loaded), why) !=
+        checkpoint::Outcome::kResumed) {
+      return 0;
+    }
+    return service->counters().seen;
+  }
+};
+
+// A status from a process started after the one that sent `before`.
+bool restarted(const msg::Status& s, const msg::Status& before) { return s.uptime_ms < before.uptime_ms; }
+
+TEST_P(CheckpointTest, SigkillMidRunResumesTheStatisticsAndTheAlarm) {
+  auto t = make_transport();
+  ASSERT_TRUE(t);
+  Observer obs(*t);
+  const std::string config = config_with_checkpoint();
+  auto mpmd = start_mpmd(config, "first");
+  ASSERT_TRUE(obs.wait_status("wb", [](const msg::Status&) { return true; })) << mpmd->stderr_text();
+  Controller c("wb", 21);
+  std::vector<msg::Sample> sent;
+
+  // Matched, then G21 x 1.5 until u1 -> y2 is raised and a checkpoint holds it.
+  ASSERT_TRUE(publish(*t, obs, c, 600, sent));
+  c.stream.set_g21_gain(1.5);
+  for (int k = 0; k < 30 && obs.alarms().empty(); ++k) ASSERT_TRUE(publish(*t, obs, c, 50, sent));
+  ASSERT_TRUE(obs.wait_alarms([](const auto& a) { return !a.empty(); }, std::chrono::seconds(10)));
+  const auto raised_at = static_cast<std::uint64_t>(obs.alarms().front().sample_sequence);
+  ASSERT_TRUE(publish(*t, obs, c, 200, sent));
+  ASSERT_TRUE(eventually([&] { return checkpointed(config) > raised_at; })) << mpmd->stderr_text();
+
+  // More samples in flight, then SIGKILL: what came after the last checkpoint is lost.
+  for (int k = 0; k < 100; ++k) {
+    sent.push_back(c.next());
+    ASSERT_TRUE(t->publish(c.sample));
+  }
+  mpmd->signal(SIGKILL);
+  ASSERT_TRUE(mpmd->wait_exit(std::chrono::seconds(10)).has_value());
+  const msg::Status before = *obs.status("wb");
+  const std::uint64_t resumed_at = checkpointed(config);
+  ASSERT_GT(resumed_at, raised_at);
+  const std::size_t alarms_before = obs.alarms().size();
+
+  auto second = start_mpmd(config, "second");
+  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return restarted(s, before); }))
+      << second->stderr_text();
+  const msg::Status resumed = *obs.status("wb");
+  EXPECT_EQ(static_cast<std::uint64_t>(resumed.samples_seen), resumed_at);
+  const double at_resume = compare(resumed, reference(config, sent, resumed_at));
+  EXPECT_LE(at_resume, 1e-12);
+  EXPECT_EQ(resumed.alarms_raised, 1);
+  EXPECT_EQ(count_lines(second->stderr_text(), "resumed from checkpoint"), 1) << second->stderr_text();
+  // The raised alarm is said again by the new process.
+  ASSERT_TRUE(obs.wait_alarms([&](const auto& a) { return a.size() > alarms_before; }, std::chrono::seconds(10)));
+  const msg::Alarm again = obs.alarms()[alarms_before];
+  EXPECT_TRUE(again.raised && again.output == "y2" && again.input == "u1") << again.text;
+  EXPECT_NE(again.text.find("still raised"), std::string::npos) << again.text;
+
+  // The controller sends again from the sample after the checkpoint, then
+  // new ones: the run ends where an uninterrupted one ends.
+  c.seq = static_cast<std::int64_t>(resumed_at);
+  c.sent = c.seq;
+  for (std::size_t k = resumed_at; k < sent.size(); ++k) {
+    ASSERT_TRUE(t->publish(sent[k]));
+    ++c.seq;
+    ++c.sent;
+  }
+  c.sample = sent.back();
+  ASSERT_TRUE(sync(obs, c));
+  ASSERT_TRUE(publish(*t, obs, c, 300, sent));
+  const msg::Status end = *obs.status("wb");
+  const double at_end = compare(end, reference(config, sent, sent.size()));
+  EXPECT_LE(at_end, 1e-12);
+  std::printf("SIGKILL after %zu samples, checkpoint at %llu: largest relative difference %.3g at resume, "
+              "%.3g after %zu samples\n",
+              sent.size() - 300, static_cast<unsigned long long>(resumed_at), at_resume, at_end, sent.size());
+
+  // SIGTERM saves the state once more.
+  second->signal(SIGTERM);
+  EXPECT_EQ(second->wait_exit(std::chrono::seconds(20)), 0);
+  EXPECT_EQ(count_lines(second->stderr_text(), "state saved to"), 1) << second->stderr_text();
+  EXPECT_EQ(checkpointed(config), sent.size());
+}
+
+TEST_P(CheckpointTest, AChangedPlantOrADamagedFileStartsFresh) {
+  auto t = make_transport();
+  ASSERT_TRUE(t);
+  Observer obs(*t);
+  const std::string config = config_with_checkpoint();
+  auto first = start_mpmd(config, "first");
+  ASSERT_TRUE(obs.wait_status("wb", [](const msg::Status&) { return true; })) << first->stderr_text();
+  Controller c("wb", 22);
+  std::vector<msg::Sample> sent;
+  ASSERT_TRUE(publish(*t, obs, c, 300, sent));
+  first->signal(SIGTERM);
+  ASSERT_EQ(first->wait_exit(std::chrono::seconds(20)), 0);
+  ASSERT_EQ(checkpointed(config), 300u);
+  msg::Status before = *obs.status("wb");
+
+  // The same plant with G21's gain changed: another model, so a fresh start.
+  std::string plant = ChildProcess::read(MPM_SOURCE_DIR "/config/wood-berry.yaml");
+  plant.replace(plant.find("num: [0.5786]"), 13, "num: [0.6000]");
+  dir().write("changed-plant.yaml", plant);
+  config_with_checkpoint(dir().file("changed-plant.yaml"));
+  auto second = start_mpmd(config, "second");
+  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return restarted(s, before); }))
+      << second->stderr_text();
+  EXPECT_EQ(obs.status("wb")->samples_seen, 0);
+  EXPECT_EQ(count_lines(second->stderr_text(), "written for another plant file"), 1) << second->stderr_text();
+  EXPECT_EQ(count_lines(second->stderr_text(), "starting fresh"), 1) << second->stderr_text();
+  second->signal(SIGTERM);
+  ASSERT_EQ(second->wait_exit(std::chrono::seconds(20)), 0);
+  before = *obs.status("wb");
+
+  // A truncated checkpoint: refused, fresh start.
+  const std::string state = dir().file("mpmd.state");
+  std::filesystem::resize_file(state, std::filesystem::file_size(state) / 2);
+  auto third = start_mpmd(config, "third");
+  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return restarted(s, before); }))
+      << third->stderr_text();
+  EXPECT_EQ(obs.status("wb")->samples_seen, 0);
+  EXPECT_EQ(count_lines(third->stderr_text(), "refused, starting fresh"), 1) << third->stderr_text();
+  third->signal(SIGTERM);
+  EXPECT_EQ(third->wait_exit(std::chrono::seconds(20)), 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Transports, CheckpointTest, ::testing::Values(transport::Kind::kLcm), kind_name);
+
+}  // namespace
+}  // namespace mpm::test
