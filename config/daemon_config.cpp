@@ -20,6 +20,14 @@ ConfigError yaml_error(const YAML::Exception& e, const std::string& source, cons
   return ConfigError(source + ":" + where + " " + what + ": " + e.msg);
 }
 
+// exists() without its throwing overload: a path too long or otherwise
+// unusable is "not there" (the caller names the key), never a
+// filesystem_error without file or line.
+bool file_exists(const std::string& path) {
+  std::error_code error;
+  return std::filesystem::exists(path, error) && !error;
+}
+
 std::string resolve(const std::string& path, const std::string& base_dir) {
   if (path.empty() || base_dir.empty() || std::filesystem::path(path).is_absolute()) return path;
   return (std::filesystem::path(base_dir) / path).lexically_normal().string();
@@ -108,7 +116,7 @@ void read_dds(const YamlReader& r, const Field& t, const std::string& base_dir, 
   // A path to an XML file is relative to this file; inline XML and URIs are kept.
   if (!dds.config.empty() && dds.config.front() != '<' && dds.config.find("://") == std::string::npos) {
     dds.config = resolve(dds.config, base_dir);
-    if (!std::filesystem::exists(dds.config))
+    if (!file_exists(dds.config))
       r.fail(r.child(f, "config"), "no such Cyclone DDS configuration file: " + dds.config);
   }
   read(r, f, "sample_topic", dds.sample_topic);
@@ -183,7 +191,7 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
     c.controller_id = r.name(r.child(root, "controller_id"));
     const Field plant = r.child(root, "plant");
     c.plant_path = resolve(r.name(plant), base_dir);
-    if (!std::filesystem::exists(c.plant_path)) r.fail(plant, "no such plant file: " + c.plant_path);
+    if (!file_exists(c.plant_path)) r.fail(plant, "no such plant file: " + c.plant_path);
     read_monitor(r, root, c);
     read_transport(r, root, base_dir, c);
     read_service(r, root, c);

@@ -12,6 +12,7 @@
 #include "daemon/args.hpp"
 #include "daemon/command.hpp"
 #include "daemon/offline.hpp"
+#include "daemon/stream_monitor.hpp"
 
 namespace mpm {
 namespace {
@@ -31,8 +32,9 @@ constexpr const char* kUsage =
     "  --false-alarm A    per-channel test level alpha (default 1e-3)\n"
     "  --plain-lags       regress on plain input lags as in the paper (default: lags of the\n"
     "                     input filtered through the nominal channel G_ji, where it is nonzero)\n"
-    "  --threads N        threads, each replaying a part of the outputs (default: one per\n"
-    "                     core, at most one per output; the result does not depend on it)\n"
+    "  --threads N        N > 1: load the whole record and replay parts of the outputs on N\n"
+    "                     threads (default: one thread, the record read as a stream, memory\n"
+    "                     independent of its length; the result does not depend on it)\n"
     "  --json             print one JSON object instead of the table\n"
     "  --events           print the live detector's raise and clear events as JSON lines\n"
     "                     (one thread; use --forgetting 0.999 for mpmd's default memory)\n"
@@ -159,19 +161,12 @@ int run(int argc, char** argv) {
     const int requested_threads = args.integer("threads", 0);  // 0: one per core
     if (args.get("threads") && requested_threads < 1) throw UsageError("--threads must be >= 1");
 
-    const config::Recording rec = config::load_recording(args.required("data"));
-    const config::BoundRecording bound = config::bind(plant, rec);
-    const ResidualSeries series = compute_residuals(plant, rec, bound);
-
-    const bool events = args.flag("events");
-    const std::size_t threads = events ? 1  // events in sample order
-                                : requested_threads > 0 ? static_cast<std::size_t>(requested_threads)
-                                                        : replay_threads(plant.n_outputs());
     std::vector<ChannelTrace> trace(plant.n_inputs() * plant.n_outputs());
     std::vector<char> raised(plant.n_outputs(), 0);
     // On each part's thread: only its outputs, so the parts write disjoint traces.
-    const GrangerMonitor monitor =
-        monitor_record(plant, series, settings, threads, args.flag("plain-lags"), [&](std::size_t k, const GrangerMonitor& m) {
+    const bool events = args.flag("events");
+    if (events && requested_threads > 1) throw UsageError("--events needs one thread (events in sample order)");
+    const PartSampleCallback on_sample = [&](std::size_t k, const GrangerMonitor& m) {
       for (std::size_t j = m.first_modelled_output(); j < m.end_modelled_output(); ++j) {
         if (m.loop(j).alarm != (raised[j] != 0)) {
           raised[j] = m.loop(j).alarm ? 1 : 0;
@@ -185,13 +180,30 @@ int run(int argc, char** argv) {
           t.was_alarm = now;
         }
       }
-    });
+    };
+    // By default the recording is streamed (memory independent of its
+    // length); --threads N > 1 loads it whole and splits the outputs.
+    std::size_t samples = 0, transient = 0;
+    const GrangerMonitor monitor = [&] {
+      if (requested_threads <= 1) {
+        StreamedRecord r = monitor_csv_stream(plant, args.required("data"), settings, args.flag("plain-lags"), on_sample);
+        samples = r.samples;
+        transient = r.transient;
+        return std::move(r.monitor);
+      }
+      const config::Recording rec = config::load_recording(args.required("data"));
+      const ResidualSeries series = compute_residuals(plant, rec, config::bind(plant, rec));
+      samples = rec.samples();
+      transient = series.transient;
+      return monitor_record(plant, series, settings, static_cast<std::size_t>(requested_threads),
+                            args.flag("plain-lags"), on_sample);
+    }();
     if (events) {
       // the events were the output
     } else if (args.flag("json")) {
-      print_json(plant, monitor, trace, rec.samples());
+      print_json(plant, monitor, trace, samples);
     } else {
-      print_table(plant, monitor, trace, rec.samples(), series.transient);
+      print_table(plant, monitor, trace, samples, transient);
     }
     return 0;
   } catch (const UsageError& e) {

@@ -191,6 +191,19 @@ TEST(StrictModes, FileOfAnotherUserIsRefused) {
   EXPECT_NE(e.find("plant.yaml: plant file is owned by uid 12345"), std::string::npos) << e;
 }
 
+// Found by fuzz_daemon_config: a plant path longer than PATH_MAX made
+// std::filesystem::exists throw filesystem_error, which no caller expects.
+TEST(DaemonConfigFuzz, OverlongPlantPathIsALocatedError) {
+  const std::string yaml = "controller_id: c\nplant: wood" + std::string(5000, 'O') + "\n";
+  const std::string e = error_of([&] { parse_daemon_config(yaml, "mpmd.yaml", ""); });
+  EXPECT_NE(e.find("mpmd.yaml:2:8: plant: no such plant file"), std::string::npos) << e;
+  const std::string dds = "controller_id: c\nplant: /dev/null\ntransport: {dds: {config: " +
+                          std::string(5000, 'x') + "}}\n";
+  const std::string d = error_of([&] { parse_daemon_config(dds, "mpmd.yaml", ""); });
+  EXPECT_NE(d.find("mpmd.yaml:3:"), std::string::npos) << d;
+  EXPECT_NE(d.find("no such Cyclone DDS configuration file"), std::string::npos) << d;
+}
+
 // --- Outputs -------------------------------------------------------------------
 
 TEST(OutputFile, AnInputIsNeverAnOutput) {

@@ -245,4 +245,48 @@ TEST(SimulateOutput, OutEqualToPlantIsRefused) {
   EXPECT_EQ(read_file(plant), before);
 }
 
+// `mpm monitor` streams the recording by default (memory independent of its
+// length; 10^7 samples of 2x2 measured in the report of issue 12) and gives
+// exactly what the whole-record parallel replay gives, also with gaps.
+TEST(MonitorStream, SameResultAsWholeRecordReplay) {
+  const std::string csv = mpm::test::per_test_tmp_path("mpm_mon_stream_", "run.csv");
+  ASSERT_EQ(run(kMpm + " simulate --scenario wood-berry-g21-gain --samples 4000 --seed 7 --out " + csv), 0);
+  // Punch NaN gaps into u2 and y1 (rows 1500..1519 and 3000).
+  std::string text = read_file(csv), gapped;
+  std::size_t line = 0, at = 0;
+  while (at < text.size()) {
+    const std::size_t end = text.find('\n', at);
+    std::string row = text.substr(at, end - at);
+    if ((line >= 1501 && line < 1521) || line == 3001) {
+      std::vector<std::string> f;
+      for (std::size_t s = 0;;) {
+        const std::size_t c = row.find(',', s);
+        f.push_back(row.substr(s, c - s));
+        if (c == std::string::npos) break;
+        s = c + 1;
+      }
+      f[2] = "";
+      f[3] = "nan";
+      row.clear();
+      for (std::size_t k = 0; k < f.size(); ++k) row += (k ? "," : "") + f[k];
+    }
+    gapped += row + "\n";
+    ++line;
+    at = end + 1;
+  }
+  std::ofstream(csv) << gapped;
+  const std::string base = kMpm + " monitor --plant " + kWoodBerry + " --data " + csv + " --json";
+  const auto streamed = mpm::test::run_captured(base, "mpm_mon_stream_a_");
+  const auto whole = mpm::test::run_captured(base + " --threads 2", "mpm_mon_stream_b_");
+  ASSERT_EQ(streamed.exit_code, 0) << streamed.err;
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  EXPECT_NE(streamed.out.find("\"samples\": 4000"), std::string::npos) << streamed.out;
+  EXPECT_EQ(streamed.out, whole.out);
+  // A located time error, the same way.
+  std::ofstream(csv) << "t,u1,u2,y1,y2\n0,1,1,1,1\n1,1,1,1,1\n3,1,1,1,1\n";
+  const auto bad = mpm::test::run_captured(kMpm + " monitor --plant " + kWoodBerry + " --data " + csv, "mpm_mon_stream_c_");
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find(csv + ":4: column 't': time goes from 1 to 3"), std::string::npos) << bad.err;
+}
+
 }  // namespace

@@ -1,0 +1,99 @@
+// `mpm monitor` over a recording read as a stream (config/csv_stream.hpp):
+// memory independent of the record's length. Two passes over the file: the
+// first checks the time column and finds what compute_residuals needs from
+// the whole record (u0 = the first complete input sample, the sample count
+// that caps the transient), the second computes each residual and updates
+// the monitor at once. The same residuals and, with the monitor updated on
+// one thread, the same statistics as compute_residuals + monitor_record,
+// which are bit for bit those of its parallel replay (offline.hpp).
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "config/csv_stream.hpp"
+#include "config/plant_loader.hpp"
+#include "core/mimo_model.hpp"
+#include "daemon/offline.hpp"
+
+namespace mpm {
+
+struct StreamedRecord {
+  GrangerMonitor monitor;
+  std::size_t samples = 0;
+  std::size_t transient = 0;
+};
+
+inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::string& path,
+                                         const MonitorSettings& settings, bool plain_lags,
+                                         const PartSampleCallback& on_sample) {
+  // Column indices and names as bind() gives them (its time check runs on
+  // the rows below, with the same message).
+  config::Recording header;
+  std::vector<double> row;
+  config::BoundRecording bound;
+  {
+    config::CsvRowReader reader(path);
+    header.source = path;
+    header.names = reader.names();
+    header.data.resize(0, static_cast<Eigen::Index>(header.names.size()));
+    bound = config::bind(plant, header);
+  }
+  const std::size_t m = plant.n_inputs(), p = plant.n_outputs();
+  const double ts = plant.sample_time;
+  std::vector<double> u0(m, 0.0);
+  bool have_u0 = plant.operating_point.has_value();
+  if (have_u0) u0 = plant.operating_point->inputs;
+  std::size_t n = 0;
+  {
+    config::CsvRowReader reader(path);
+    double last_t = 0.0;
+    while (reader.next(row)) {
+      const double t = row[bound.time];
+      auto fail = [&](const std::string& what) {
+        throw config::ConfigError(path + ":" + std::to_string(n + 2) + ": column 't': " + what);
+      };
+      if (std::isnan(t)) fail("time is missing");
+      if (n > 0) {
+        const double tolerance = 1e-6 * ts + 4 * std::numeric_limits<double>::epsilon() * std::abs(t);
+        if (std::abs(t - last_t - ts) > tolerance) {
+          char text[160];
+          std::snprintf(text, sizeof text, "time goes from %.10g to %.10g, expected a step of sample_time = %.10g",
+                        last_t, t, ts);
+          fail(text);
+        }
+      }
+      last_t = t;
+      if (!have_u0) {
+        bool complete = true;
+        for (std::size_t i = 0; i < m; ++i) complete = complete && std::isfinite(row[bound.inputs[i]]);
+        if (complete) {
+          for (std::size_t i = 0; i < m; ++i) u0[i] = row[bound.inputs[i]];
+          have_u0 = true;
+        }
+      }
+      ++n;
+    }
+  }
+  bool all_sim = true;
+  for (std::size_t j = 0; j < p; ++j) all_sim = all_sim && bound.sim[j].has_value();
+  StreamedRecord out{monitor_factory(plant, settings, plain_lags)(OutputRange{}), n,
+                     all_sim ? 0 : settling_samples(plant, 0.01, n / 10)};
+  ResidualGenerator gen(plant, u0);
+  std::vector<double> u(m), y(p), r(p), d(p);
+  config::CsvRowReader reader(path);
+  for (std::size_t k = 0; reader.next(row); ++k) {
+    for (std::size_t i = 0; i < m; ++i) u[i] = row[bound.inputs[i]];
+    for (std::size_t j = 0; j < p; ++j) y[j] = row[bound.outputs[j]];
+    gen.step(u.data(), y.data(), r.data());
+    for (std::size_t j = 0; j < p; ++j) d[j] = bound.sim[j] ? y[j] - row[*bound.sim[j]] : r[j];
+    if (k < out.transient) continue;
+    out.monitor.update(u.data(), d.data());
+    if (on_sample) on_sample(k, out.monitor);
+  }
+  return out;
+}
+
+}  // namespace mpm
