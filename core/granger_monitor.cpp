@@ -42,7 +42,7 @@ constexpr std::uint64_t kFirstWindowEvery = 4;
 // A long window is tested once its information has had this many refreshes:
 // before, J_W is a few snapshots of S against a score summed over
 // everything in between (measured: raises at the first refreshes).
-constexpr std::uint32_t kMinRefreshes = 8;
+constexpr std::uint32_t kMinRefreshes = 3;
 constexpr double kJumpMemory = 0.995;
 constexpr int kOutlierRunAccept = 5;
 // Mean absolute value of a standard normal: mean |change| / this = sigma.
@@ -485,7 +485,10 @@ void GrangerMonitor::refresh_long_windows() noexcept {
   detector_.refresh_information(j, k, info_scratch_, gap);
   std::uint32_t& count = refresh_count_[j * kw + k];
   if (count < kMinRefreshes) ++count;
-  if (count < kMinRefreshes || !detector_.has_information(j, k) || loops_[j].diverging) return;
+  // ... and once the score has run for half the first window's memory.
+  if (count < kMinRefreshes || output_used_[j] < burn_in_ + static_cast<std::uint64_t>(detector_.window(0) / 2) ||
+      !detector_.has_information(j, k) || loops_[j].diverging)
+    return;
   // T = s^T J^-1 s / sigma_W^2, both of the window's own memory.
   const double var = detector_.variance(j, k);
   const double t = detector_.normalised_quadratic(j, k) / var;
