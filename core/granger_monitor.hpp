@@ -234,6 +234,7 @@ class GrangerMonitor {
     v(last_good_);
     v(jump_scale_);
     v(outlier_run_);
+    v(screened_);
     v(refresh_last_);
     v(refresh_count_);
     v(refresh_tick_);
@@ -336,6 +337,7 @@ class GrangerMonitor {
   std::vector<double> last_good_;
   std::vector<double> jump_scale_;
   std::vector<int> outlier_run_;
+  std::vector<std::uint64_t> screened_;      // samples screened since the output's (re)start
   std::vector<double> clean_;
   // Divergence detection per output: running mean and variance of d~ with a
   // short memory, and the quietest variance seen (the baseline).
