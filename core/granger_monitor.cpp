@@ -42,7 +42,7 @@ constexpr std::uint64_t kFirstWindowEvery = 4;
 // A long window is tested once its information has had this many refreshes:
 // before, J_W is a few snapshots of S against a score summed over
 // everything in between (measured: raises at the first refreshes).
-constexpr std::uint32_t kMinRefreshes = 8;
+constexpr std::uint32_t kMinRefreshes = 3;
 constexpr double kJumpMemory = 0.995;
 constexpr int kOutlierRunAccept = 5;
 // Mean absolute value of a standard normal: mean |change| / this = sigma.
@@ -196,6 +196,7 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   last_good_.assign(n_outputs, 0.0);
   jump_scale_.assign(n_outputs, 0.0);
   outlier_run_.assign(n_outputs, 0);
+  screened_.assign(n_outputs, 0);
   clean_.assign(n_outputs, 0.0);
   reset();
 }
@@ -221,6 +222,7 @@ void GrangerMonitor::reset() noexcept {
   std::fill(output_sum_w_.begin(), output_sum_w_.end(), 0.0);
   std::fill(jump_scale_.begin(), jump_scale_.end(), 0.0);
   std::fill(outlier_run_.begin(), outlier_run_.end(), 0);
+  std::fill(screened_.begin(), screened_.end(), 0);
   std::fill(refresh_last_.begin(), refresh_last_.end(), burn_in_);
   std::fill(refresh_count_.begin(), refresh_count_.end(), 0);
   refresh_tick_ = 0;
@@ -238,6 +240,7 @@ void GrangerMonitor::reset_output(std::size_t j) noexcept {
   output_sum_w_[j] = 0.0;
   jump_scale_[j] = 0.0;
   outlier_run_[j] = 0;
+  screened_[j] = 0;
   for (std::size_t k = 0; k < detector_.windows(); ++k) {
     refresh_last_[j * detector_.windows() + k] = burn_in_;
     refresh_count_[j * detector_.windows() + k] = 0;
@@ -302,10 +305,12 @@ SampleStatus GrangerMonitor::update(const double* u, const double* residual) noe
 bool GrangerMonitor::screen_outliers(const double* residual) noexcept {
   if (settings_.outlier_limit == 0.0) return false;
   bool outlier = false;
-  for (std::size_t j = first_output_; j < end_output_; ++j) {
+  // Every output, modelled or not: a monitor of a part of the outputs skips
+  // exactly the samples the whole monitor skips.
+  for (std::size_t j = 0; j < n_outputs_; ++j) {
     clean_[j] = residual[j];
     const double jump = std::abs(residual[j] - last_good_[j]);
-    const std::uint64_t n = output_used_[j];
+    const std::uint64_t n = screened_[j]++;
     double& scale = jump_scale_[j];  // mean |one-step change|
     if (n == 0) {  // first sample after a (re)start: nothing to compare with
       last_good_[j] = residual[j];
@@ -330,7 +335,7 @@ bool GrangerMonitor::screen_outliers(const double* residual) noexcept {
   if (outlier) {
     // Nothing of this sample enters any output's statistics; the outputs
     // that were fine keep their value as the last good one.
-    for (std::size_t j = first_output_; j < end_output_; ++j)
+    for (std::size_t j = 0; j < n_outputs_; ++j)
       if (clean_[j] == residual[j] && outlier_run_[j] == 0) last_good_[j] = residual[j];
   }
   return outlier;
@@ -485,7 +490,10 @@ void GrangerMonitor::refresh_long_windows() noexcept {
   detector_.refresh_information(j, k, info_scratch_, gap);
   std::uint32_t& count = refresh_count_[j * kw + k];
   if (count < kMinRefreshes) ++count;
-  if (count < kMinRefreshes || !detector_.has_information(j, k) || loops_[j].diverging) return;
+  // ... and once the score has run for half the first window's memory.
+  if (count < kMinRefreshes || output_used_[j] < burn_in_ + static_cast<std::uint64_t>(detector_.window(0) / 2) ||
+      !detector_.has_information(j, k) || loops_[j].diverging)
+    return;
   // T = s^T J^-1 s / sigma_W^2, both of the window's own memory.
   const double var = detector_.variance(j, k);
   const double t = detector_.normalised_quadratic(j, k) / var;
@@ -617,6 +625,7 @@ void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
     last_good_[j] = part.last_good_[j];
     jump_scale_[j] = part.jump_scale_[j];
     outlier_run_[j] = part.outlier_run_[j];
+    screened_[j] = part.screened_[j];
     detector_.adopt_output(part.detector_, j);
     for (std::size_t k = 0; k < detector_.windows(); ++k) {
       refresh_last_[j * detector_.windows() + k] = part.refresh_last_[j * detector_.windows() + k];
@@ -626,8 +635,13 @@ void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
     var_fast_[jj] = part.var_fast_[jj];
     var_baseline_[jj] = part.var_baseline_[jj];
   }
-  // What every part computed alike from the same samples.
+  // What every part computed alike from the same samples; raises and resets
+  // are of each part's own outputs, so they add up.
+  const std::uint64_t raises = counters_.raises + part.counters_.raises;
+  const std::uint64_t resets = counters_.resets + part.counters_.resets;
   counters_ = part.counters_;
+  counters_.raises = raises;
+  counters_.resets = resets;
   in_gap_ = part.in_gap_;
   used_since_reset_ = part.used_since_reset_;
   lags_filled_ = part.lags_filled_;

@@ -237,7 +237,7 @@ class GrangerMonitor {
     v(residual_lags_); v(input_lags_); v(channel_filters_); v(lags_filled_); v(input_ref_);
     v(regressions_); v(channels_); v(loops_); v(counters_); v(in_gap_); v(used_since_reset_);
     v(sum_w_); v(sum_w2_); v(n_eq_); v(mean_fast_); v(var_fast_); v(var_baseline_);
-    v(output_used_); v(output_sum_w_); v(last_good_); v(jump_scale_); v(outlier_run_);
+    v(output_used_); v(output_sum_w_); v(last_good_); v(jump_scale_); v(outlier_run_); v(screened_);
     v(refresh_last_); v(refresh_count_); v(refresh_tick_); v(refresh_cursor_);
     detector_.visit_state(v);
   }
@@ -328,6 +328,7 @@ class GrangerMonitor {
   std::vector<double> last_good_;
   std::vector<double> jump_scale_;
   std::vector<int> outlier_run_;
+  std::vector<std::uint64_t> screened_;      // samples screened since the output's (re)start
   std::vector<double> clean_;
   // Divergence detection per output: running mean and variance of d~ with a
   // short memory, and the quietest variance seen (the baseline).

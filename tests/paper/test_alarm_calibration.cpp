@@ -52,7 +52,7 @@ TEST(AlarmCalibration, NoMismatchRaisesAtTheStatedRatePerUnitTime) {
     const char* file;
     int runs;
   };
-  const int scale = kSanitized ? 1 : 4;
+  const int scale = kSanitized ? 1 : 3;
   const Case cases[] = {{"wood-berry.yaml", 2 * scale}, {"three-by-three.yaml", scale}, {"quad-tank.yaml", 2 * scale}};
   const std::size_t samples = 30000;
   std::size_t raises = 0, first_half = 0, monitored = 0;

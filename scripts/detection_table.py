@@ -1,0 +1,53 @@
+#!/usr/bin/env python3
+"""Detection table (issue 11): every shared case in DATA/*/ (plant.yaml,
+run.csv, truth.json) replayed whole through the live path (mpm monitor
+--events with mpmd's defaults: forgetting 0.999, one false alarm per year)
+beside mpm diagnose's offline verdict. Prints per case: the truth, the
+offline verdict (mismatched outputs), the live raises (output, channel,
+sample of the first raise) and whether live agrees.
+
+usage: scripts/detection_table.py [--mpm build/daemon/mpm] [--data /work/shared/data]
+"""
+import argparse, glob, json, os, subprocess, sys
+
+
+def main():
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--mpm", default=os.path.join(root, "build", "daemon", "mpm"))
+    ap.add_argument("--data", default="/work/shared/data")
+    args = ap.parse_args()
+    print(f"{'case':38s} {'truth':18s} {'offline':14s} {'live raises (output/channel@sample)':44s} agree")
+    for case in sorted(glob.glob(os.path.join(args.data, "*", "truth.json"))):
+        d = os.path.dirname(case)
+        name = os.path.basename(d)
+        truth = json.load(open(case))
+        t = truth.get("mismatch")
+        true_channels = sorted({f"{c['output']}/{c['input']}" for f in (truth.get("findings") or []) for c in (f.get("channels") or [])})
+        plant, run = os.path.join(d, "plant.yaml"), os.path.join(d, "run.csv")
+        off = subprocess.run([args.mpm, "diagnose", "--quiet", "--plant", plant, "--data", run], capture_output=True, text=True)
+        try:
+            diag = json.loads(off.stdout)
+            offline = [l["output"] for l in diag["loops"] if l.get("mismatch")]
+        except (ValueError, KeyError):
+            offline = ["error"]
+        ev = subprocess.run([args.mpm, "monitor", "--plant", plant, "--data", run, "--forgetting", "0.999", "--events"],
+                            capture_output=True, text=True)
+        raises = [json.loads(l) for l in ev.stdout.splitlines() if '"raised"' in l]
+        first = {}
+        for e in raises:
+            first.setdefault(e["output"], f"{e['output']}/{e['channel']}@{e['sample']}")
+        live_outputs = sorted(first)
+        if t is None:
+            agree = "n/a"
+        elif t:
+            agree = "yes" if offline and set(offline) <= set(live_outputs) else ("missed" if offline and offline != ["error"] else "-")
+        else:
+            agree = "yes" if not live_outputs else "FALSE ALARM"
+        truth_text = ("none" if t is False else "unknown" if t is None else ",".join(true_channels) or "yes")
+        print(f"{name:38s} {truth_text[:18]:18s} {','.join(offline) or 'none':14s} {' '.join(first.values()) or 'none':44s} {agree}",
+              flush=True)
+
+
+if __name__ == "__main__":
+    main()
