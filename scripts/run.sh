@@ -12,12 +12,16 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+# This machine's build: x86-64-v3 (AVX2, FMA) where the processor has it, the
+# monitor's update is ~3.7x faster so; the CMake default stays portable (the .deb).
+native=OFF
+grep -qw avx2 /proc/cpuinfo && grep -qw fma /proc/cpuinfo && native=ON
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMPM_NATIVE_ARCH=$native >/dev/null
 cmake --build build -j"$(nproc)"
 mkdir -p out/mission
 echo
 echo "=== The mission: a concealed mismatch, located, named, fitted, written back ==="
-python3 scripts/mission.py build/daemon/mpm config/wood-berry.yaml out/mission
+/usr/bin/python3 scripts/mission.py build/daemon/mpm config/wood-berry.yaml out/mission
 echo
 echo "=== The paper's case studies (Chen, Xie & Su 2021) ==="
 build/daemon/mpm paper --out out

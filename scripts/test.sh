@@ -9,7 +9,11 @@ jobs=$(nproc)
 status=0
 
 echo "== Release build and tests"
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+# This machine's build: x86-64-v3 (AVX2, FMA) where the processor has it, the
+# monitor's update is ~3.7x faster so; the CMake default stays portable (the .deb).
+native=OFF
+grep -qw avx2 /proc/cpuinfo && grep -qw fma /proc/cpuinfo && native=ON
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMPM_NATIVE_ARCH=$native >/dev/null
 cmake --build build -j"$jobs"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 600 || status=1
 

@@ -9,4 +9,4 @@ mkdir -p "$work"
 "$mpm" diagnose --quiet --plant "$src/config/wood-berry.yaml" --data "$work/run.csv" --json "$work/report.json" \
   --html "$work/report.html"
 grep -q '"physics": "gain"' "$work/report.json"
-python3 "$src/tests/product/render_report.py" "$work/report.html" "$work/report.png"
+/usr/bin/python3 "$src/tests/product/render_report.py" "$work/report.html" "$work/report.png"

@@ -15,4 +15,4 @@ for case in wood-berry-nominal:wood-berry wood-berry-g21-gain:wood-berry wood-be
   "$mpm" diagnose --quiet --plant "$src/config/$plant.yaml" --data "$work/$scenario.csv" --json "$work/$scenario.json"
   reports="$reports $work/$scenario.json"
 done
-python3 "$src/tests/product/validate_reports.py" "$src/docs/diagnosis.schema.json" $reports
+/usr/bin/python3 "$src/tests/product/validate_reports.py" "$src/docs/diagnosis.schema.json" $reports
