@@ -110,8 +110,13 @@ class CheckpointTest : public LoopbackTest {
   }
 };
 
-// A status from a process started after the one that sent `before`.
-bool restarted(const msg::Status& s, const msg::Status& before) { return s.uptime_ms < before.uptime_ms; }
+// Now, as a status's utime counts: a status made after it comes from a
+// process started after the previous one ended.
+std::int64_t unix_micros() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+bool restarted(const msg::Status& s, std::int64_t after) { return s.utime >= after; }
 
 TEST_P(CheckpointTest, SigkillMidRunResumesTheStatisticsAndTheAlarm) {
   auto t = make_transport();
@@ -139,13 +144,13 @@ TEST_P(CheckpointTest, SigkillMidRunResumesTheStatisticsAndTheAlarm) {
   }
   mpmd->signal(SIGKILL);
   ASSERT_TRUE(mpmd->wait_exit(std::chrono::seconds(10)).has_value());
-  const msg::Status before = *obs.status("wb");
+  const std::int64_t killed = unix_micros();
   const std::uint64_t resumed_at = checkpointed(config);
   ASSERT_GT(resumed_at, raised_at);
   const std::size_t alarms_before = obs.alarms().size();
 
   auto second = start_mpmd(config, "second");
-  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return restarted(s, before); }))
+  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return restarted(s, killed); }))
       << second->stderr_text();
   const msg::Status resumed = *obs.status("wb");
   EXPECT_EQ(static_cast<std::uint64_t>(resumed.samples_seen), resumed_at);
@@ -198,7 +203,7 @@ TEST_P(CheckpointTest, AChangedPlantOrADamagedFileStartsFresh) {
   first->signal(SIGTERM);
   ASSERT_EQ(first->wait_exit(std::chrono::seconds(20)), 0);
   ASSERT_EQ(checkpointed(config), 300u);
-  msg::Status before = *obs.status("wb");
+  std::int64_t stopped = unix_micros();
 
   // The same plant with G21's gain changed: another model, so a fresh start.
   std::string plant = ChildProcess::read(MPM_SOURCE_DIR "/config/wood-berry.yaml");
@@ -206,20 +211,20 @@ TEST_P(CheckpointTest, AChangedPlantOrADamagedFileStartsFresh) {
   dir().write("changed-plant.yaml", plant);
   config_with_checkpoint(dir().file("changed-plant.yaml"));
   auto second = start_mpmd(config, "second");
-  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return restarted(s, before); }))
+  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return restarted(s, stopped); }))
       << second->stderr_text();
   EXPECT_EQ(obs.status("wb")->samples_seen, 0);
   EXPECT_EQ(count_lines(second->stderr_text(), "written for another plant file"), 1) << second->stderr_text();
   EXPECT_EQ(count_lines(second->stderr_text(), "starting fresh"), 1) << second->stderr_text();
   second->signal(SIGTERM);
   ASSERT_EQ(second->wait_exit(std::chrono::seconds(20)), 0);
-  before = *obs.status("wb");
+  stopped = unix_micros();
 
   // A truncated checkpoint: refused, fresh start.
   const std::string state = dir().file("mpmd.state");
   std::filesystem::resize_file(state, std::filesystem::file_size(state) / 2);
   auto third = start_mpmd(config, "third");
-  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return restarted(s, before); }))
+  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return restarted(s, stopped); }))
       << third->stderr_text();
   EXPECT_EQ(obs.status("wb")->samples_seen, 0);
   EXPECT_EQ(count_lines(third->stderr_text(), "refused, starting fresh"), 1) << third->stderr_text();
