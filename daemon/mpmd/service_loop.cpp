@@ -115,7 +115,9 @@ void ServiceLoop::feed_watchdog(Clock::time_point now) {
 
 // A SIGHUP storm must not flood the journal: the lines of a reload are
 // rate-limited like every other kind of log line (the first at once, then
-// at most one per log_interval, saying how many reloads were not reported).
+// at most one per log_interval, saying how many reloads were not reported);
+// a reload error other than the last one logged, new monitor settings and
+// the first good reload after errors are always reported.
 void ServiceLoop::apply_reload() {
   notifier_.reloading();
   reload_throttle_.set_interval(std::chrono::duration<double>(running_.config.log_interval));
@@ -128,9 +130,12 @@ void ServiceLoop::apply_reload() {
   std::string error;
   auto next = load_config(config_path_, error);
   if (!next) {
-    if (report) {
+    // A different error is news to the operator who just edited the file:
+    // reported whatever the throttle says (a storm repeats one error).
+    if (report || error != last_reload_error_) {
       log::write(log::Level::kError, "reload failed, keeping the running configuration: %s%s", error.c_str(),
                  suppressed);
+      last_reload_error_ = error;
     }
     notifier_.ready("reload failed; running the previous configuration");
     return;
@@ -149,10 +154,11 @@ void ServiceLoop::apply_reload() {
   if (next->monitor_fingerprint != running_.monitor_fingerprint) {
     auto service = make_service(*next, service_->alarm_sink(), error);
     if (!service) {
-      if (report) {
-      log::write(log::Level::kError, "reload failed, keeping the running configuration: %s%s", error.c_str(),
-                 suppressed);
-    }
+      if (report || error != last_reload_error_) {
+        log::write(log::Level::kError, "reload failed, keeping the running configuration: %s%s", error.c_str(),
+                   suppressed);
+        last_reload_error_ = error;
+      }
       notifier_.ready("reload failed; running the previous configuration");
       return;
     }
@@ -162,16 +168,17 @@ void ServiceLoop::apply_reload() {
     limits.n_u = static_cast<std::uint32_t>(next->plant.n_inputs());
     limits.n_y = static_cast<std::uint32_t>(next->plant.n_outputs());
     transport_.set_sample_limits(limits);
-    if (report) {
-      log::write(log::Level::kNotice, "reloaded %s: new monitor settings, statistics start again%s",
-                 config_path_.c_str(), suppressed);
-    }
+    // Always said: the statistics restart (a storm of SIGHUPs over one file
+    // changes the settings once).
+    log::write(log::Level::kNotice, "reloaded %s: new monitor settings, statistics start again%s",
+               config_path_.c_str(), suppressed);
   } else {
-    if (report) {
+    if (report || !last_reload_error_.empty()) {  // throttled, unless it ends a run of errors
       log::write(log::Level::kNotice, "reloaded %s: monitor unchanged, statistics kept%s", config_path_.c_str(),
                  suppressed);
     }
   }
+  last_reload_error_.clear();
   running_ = std::move(*next);
   notifier_.ready("reloaded");
 }

@@ -61,6 +61,7 @@ class ServiceLoop {
   Throttle checkpoint_failures_;
   msg::Status status_;
   Throttle reload_throttle_;
+  std::string last_reload_error_;  // the last reload error logged ("" after a good reload)
 };
 
 }  // namespace mpm

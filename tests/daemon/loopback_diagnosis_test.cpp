@@ -24,7 +24,7 @@ double parameter(const msg::Diagnosis& d, const std::string& name) {
 TEST_P(DiagnosisTest, ARaiseIsFollowedByItsPhysics) {
   // The MPC's closed loop with the mismatch, recorded.
   ChildProcess sim({kMpm, "simulate", "--scenario", "wood-berry-g21-gain", "--edit", "y2.u1.gain=3", "--samples",
-                    "1500", "--seed", "1", "--out", dir().file("run.csv")},
+                    "5000", "--seed", "1", "--out", dir().file("run.csv")},
                    dir().file("sim.out"), dir().file("sim.err"));
   ASSERT_EQ(sim.wait_exit(std::chrono::seconds(60)), 0) << sim.stderr_text();
 
