@@ -181,10 +181,10 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   locate_v_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d));
   locate_block_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nb_), static_cast<Eigen::Index>(nb_));
   locate_x_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(nb_));
-  locate_llt_ = Eigen::LLT<Eigen::MatrixXd>(static_cast<Eigen::Index>(nb_));
+  locate_llt_ = factored_identity(static_cast<Eigen::Index>(nb_));
   if (detector_.windows() > 1) {
     info_scratch_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
-    info_llt_ = Eigen::LLT<Eigen::MatrixXd>(static_cast<Eigen::Index>(d));
+    info_llt_ = factored_identity(static_cast<Eigen::Index>(d));
   }
   // The score starts once the factor's memory is full: before, the AR
   // reference and S are estimates from a few hundred samples and the score

@@ -313,12 +313,12 @@ class GrangerMonitor {
   Eigen::VectorXd locate_v_;                 // m nb
   Eigen::MatrixXd locate_block_;             // nb x nb
   Eigen::VectorXd locate_x_;                 // nb
-  Eigen::LLT<Eigen::MatrixXd> locate_llt_;
+  Eigen::LLT<Eigen::MatrixXd> locate_llt_ = factored_identity(0);
   // Long windows' information refresh: one (output, window) every few
   // samples, round robin over every output (modelled or not, so a part of
   // the outputs refreshes exactly as the whole monitor does).
   Eigen::MatrixXd info_scratch_;               // m nb x m nb
-  Eigen::LLT<Eigen::MatrixXd> info_llt_;       // m nb (covariance form: S = P^-1)
+  Eigen::LLT<Eigen::MatrixXd> info_llt_ = factored_identity(0);      // m nb (covariance form: S = P^-1)
   std::vector<std::uint64_t> refresh_last_;    // output_used_ at each pair's last refresh
   std::vector<std::uint32_t> refresh_count_;   // refreshes since the output's (re)start
   std::uint64_t refresh_tick_ = 0;

@@ -102,11 +102,11 @@ SequentialDetector::SequentialDetector(std::size_t outputs, std::size_t dof, con
   raised_.assign(outputs, 0);
   cursor_.assign(outputs, 0);
   info_.assign(outputs * static_cast<std::size_t>(k), Eigen::MatrixXd());
-  chol_.assign(outputs * static_cast<std::size_t>(k), Eigen::LLT<Eigen::MatrixXd>());
+  chol_.assign(outputs * static_cast<std::size_t>(k), factored_identity(0));
   for (std::size_t j = 0; j < outputs; ++j)
     for (Eigen::Index w = 1; w < k; ++w) {
       info_[j * static_cast<std::size_t>(k) + static_cast<std::size_t>(w)] = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(dof), static_cast<Eigen::Index>(dof));
-      chol_[j * static_cast<std::size_t>(k) + static_cast<std::size_t>(w)] = Eigen::LLT<Eigen::MatrixXd>(static_cast<Eigen::Index>(dof));
+      chol_[j * static_cast<std::size_t>(k) + static_cast<std::size_t>(w)] = factored_identity(static_cast<Eigen::Index>(dof));
     }
   info_ok_.assign(outputs * static_cast<std::size_t>(k), 0);
   var_.assign(outputs * static_cast<std::size_t>(k), 0.0);

@@ -55,6 +55,14 @@
 
 namespace mpm {
 
+// A Cholesky factor of the n x n identity: storage sized at setup and every
+// member set. Eigen's default and size constructors leave the factor's
+// status unset, and copying such an object (a vector fill, a monitor copy)
+// reads it: undefined behaviour that UBSan reports.
+inline Eigen::LLT<Eigen::MatrixXd> factored_identity(Eigen::Index n) {
+  return Eigen::LLT<Eigen::MatrixXd>(Eigen::MatrixXd::Identity(n, n));
+}
+
 // Fitted by simulation of the ideal chi-square process (see the overview).
 inline constexpr double kCrossingConstant = 0.7;
 inline constexpr double kOvershootBeta = 3.5;
