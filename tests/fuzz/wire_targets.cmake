@@ -10,11 +10,11 @@
 # Seeds: corpus/lcm_sample and corpus/dds_sample, written by make_wire_seeds
 # (below; re-run it after changing transport/messages/) plus inputs the
 # fuzzers found worth keeping.
-mpm_add_fuzzer(NAME fuzz_lcm_sample
+mpm_add_fuzzer(lcm_sample
   SOURCE ${CMAKE_CURRENT_LIST_DIR}/fuzz_lcm_sample.cpp
   LIBS mpm_transport mpm_lcm_types
   CORPUS ${CMAKE_CURRENT_LIST_DIR}/corpus/lcm_sample)
-mpm_add_fuzzer(NAME fuzz_dds_sample
+mpm_add_fuzzer(dds_sample
   SOURCE ${CMAKE_CURRENT_LIST_DIR}/fuzz_dds_sample.cpp
   LIBS mpm_transport mpm_dds_types
   CORPUS ${CMAKE_CURRENT_LIST_DIR}/corpus/dds_sample)
