@@ -164,7 +164,10 @@ Recording parse_recording(const std::string& csv_text, const std::string& source
   values.reserve(std::min(lines_left * cols, text.size() + cols));
   while (!lines.only_blank_left()) {
     const std::string_view line = lines.next();
-    detail::parse_csv_row(line, lines.number(), rec.names, source_name, values);
+    // A blank line before more data is a row of empty fields, whatever
+    // blanks it holds (as CsvRowReader reads it: found by fuzz_csv).
+    detail::parse_csv_row(detail::is_blank_line(line) ? std::string_view{} : line, lines.number(), rec.names,
+                          source_name, values);
   }
   const auto rows = static_cast<Eigen::Index>(values.size() / cols);
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;

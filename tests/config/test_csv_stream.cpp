@@ -67,6 +67,8 @@ TEST(CsvStream, SameErrors) {
   expect_same("t,u1,y1\n0,1,2\n1,x,2\n", "bad_value");
   expect_same("t,u1,y1\n0,1,2\n1,2\n", "short_row");
   expect_same("t,u1,y1\n0,1,inf\n", "infinite");
+  // A blank line of carriage returns before more data (found by fuzz_csv).
+  expect_same("1\n\r\r\n1D,2,3\r\n1,,\r\n", "blank_cr_line_before_data");
 }
 
 TEST(CsvStream, RowsAcrossReadChunks) {
