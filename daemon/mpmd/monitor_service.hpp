@@ -141,7 +141,8 @@ class MonitorService {
   void visit_state(V&& v) {
     bool has_residuals = residuals_.has_value();
     v(has_residuals);
-    // On reading: a placeholder u0, overwritten by the residual model's own state.
+    // When reading, the residual model is first built with u0 = 0 so the
+    // visitor has an object to fill; its saved state, u0 included, replaces it.
     if (has_residuals && !residuals_) residuals_.emplace(plant_, std::vector<double>(plant_.n_inputs(), 0.0));
     if (!has_residuals) residuals_.reset();
     if (residuals_) v(*residuals_);
