@@ -67,7 +67,7 @@ diagnosis::Result diagnose_files(const std::string& plant_path, const std::strin
   const ResidualSeries series = compute_residuals(plant, rec, bound);
 
   MonitorSettings settings;
-  settings.forgetting = 1.0;
+  settings.forgetting = kRecordForgetting;
   threads = replay_threads(plant.n_outputs());
   const GrangerMonitor monitor = monitor_record(plant, series, settings, threads);
   const RecordVerdict verdict = record_verdict(monitor);

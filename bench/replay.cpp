@@ -13,7 +13,7 @@
 #include "config/plant_loader.hpp"
 #include "core/granger_monitor.hpp"
 #include "core/mimo_model.hpp"
-#include "core/noise_filter.hpp"
+#include "core/monitor_front_end.hpp"
 #include "daemon/offline.hpp"
 #include "sim/builtin_plants.hpp"
 
@@ -57,8 +57,9 @@ ReplayResult measure_replay(std::size_t samples) {
 
   const MonitorSettings settings = paper_settings();
   ResidualGenerator residuals(plant, std::vector<double>(m, 0.0));
-  const auto noise = noise_ar(plant, settings.ar_order);
-  GrangerMonitor monitor(m, n, settings, noise);
+  // The paper's monitor of the plant (plain lags), built as every command builds it.
+  const MonitorBlueprint blueprint(plant, settings, /*plain_lags=*/true);
+  GrangerMonitor monitor = blueprint.build();
   std::vector<double> d(n);
 
   ReplayResult r;
@@ -81,7 +82,7 @@ ReplayResult measure_replay(std::size_t samples) {
   std::vector<double> inputs(samples * m), residual(samples * n);
   for (std::size_t k = 0; k < samples; ++k)
     std::copy(data.data() + k * (m + n), data.data() + k * (m + n) + m, inputs.data() + k * m);
-  const auto make = [&](OutputRange outputs) { return GrangerMonitor(m, n, settings, noise, {}, {}, outputs); };
+  const auto make = [&](OutputRange outputs) { return blueprint.build(outputs); };
   r.threads = replay_threads(n);
   // Wall-clock time on a shared machine: the other core may be taken for a
   // while by another tenant, so the median of a few runs.

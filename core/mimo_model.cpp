@@ -50,6 +50,11 @@ void ResidualGenerator::step(const double* u, const double* y, double* residual)
     residual[j] = input_missing ? NAN : y[j] - y_model_[j];
 }
 
+void ResidualGenerator::set_origin(const double* u0) noexcept {
+  std::copy(u0, u0 + u0_.size(), u0_.begin());
+  last_good_u_ = u0_;
+}
+
 }  // namespace mpm
 
 namespace mpm {

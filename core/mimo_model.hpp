@@ -57,6 +57,9 @@ class ResidualGenerator {
   // A NaN in u makes the affected outputs' residuals NaN at k; the model
   // holds the last good input value for that input (zero-order hold).
   void step(const double* u, const double* y, double* residual) noexcept;
+  // Sets u0 (n_inputs values) before the first step, when it is found in the
+  // data (monitor_front_end.hpp). Real-time safe: sizes are kept.
+  void set_origin(const double* u0) noexcept;
   // Calls v(member) for every member that changes after setup (checkpoint).
   template <class V>
   void visit_state(V&& v) {

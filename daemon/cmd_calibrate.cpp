@@ -63,7 +63,7 @@ int run(int argc, char** argv) {
     if (!out.empty() && std::filesystem::exists(out))
       throw UsageError("--out " + out + " exists: calibrate never overwrites a file");
 
-    const GrangerMonitor shape = monitor_factory(plant, settings, false)(OutputRange{});
+    const GrangerMonitor shape = MonitorBlueprint(plant, settings).build();
     const SequentialDetector& det = shape.detector();
     const double d = static_cast<double>(det.dof());
     std::vector<std::vector<double>> levels(det.windows());

@@ -189,7 +189,7 @@ int run(int argc, char** argv) {
     progress("residuals computed; running the Granger monitor over the record");
 
     MonitorSettings settings;
-    settings.forgetting = 1.0;
+    settings.forgetting = kRecordForgetting;
     const GrangerMonitor monitor = monitor_record(plant, series, settings, replay_threads(plant.n_outputs()));
     const RecordVerdict verdict = record_verdict(monitor);
     // A header-only or all-NaN record leaves every statistic at its prior

@@ -32,12 +32,17 @@ constexpr const char* kUsage =
     "  --false-alarm A    per-channel test level alpha (default 1e-3)\n"
     "  --plain-lags       regress on plain input lags as in the paper (default: lags of the\n"
     "                     input filtered through the nominal channel G_ji, where it is nonzero)\n"
+    "  --settle-samples N samples skipped while the nominal model's start-up transient\n"
+    "                     decays (mpmd's settle_samples; default: none when every output has a\n"
+    "                     sim_ column, else the plant's 1 % settling time, at most a tenth of\n"
+    "                     the record)\n"
     "  --threads N        N > 1: load the whole record and replay parts of the outputs on N\n"
     "                     threads (default: one thread, the record read as a stream, memory\n"
     "                     independent of its length; the result does not depend on it)\n"
     "  --json             print one JSON object instead of the table\n"
-    "  --events           print the live detector's raise and clear events as JSON lines\n"
-    "                     (one thread; use --forgetting 0.999 for mpmd's default memory)\n"
+    "  --events           print the live detector's raise and clear events of each channel\n"
+    "                     as JSON lines: the alarms mpmd publishes for the same samples and\n"
+    "                     settings (one thread; --forgetting 0.999 is mpmd's default memory)\n"
     "  --false-alarms-per-year R  stated false-alarm rate of the live detector for the\n"
     "                     whole controller (default 1; the sample time is the plant's)\n"
     "  --crossing-constant C  the detector's crossing-rate constant (from mpm calibrate)\n"
@@ -55,7 +60,6 @@ std::string num(double v) {
 struct ChannelTrace {
   long raised_at = -1;  // first sample the alarm was raised
   long cleared_at = -1; // last sample it cleared
-  bool was_alarm = false;
 };
 
 void print_table(const PlantModel& plant, const GrangerMonitor& m, const std::vector<ChannelTrace>& trace,
@@ -116,31 +120,32 @@ void print_json(const PlantModel& plant, const GrangerMonitor& m, const std::vec
               static_cast<unsigned long long>(k.raises));
 }
 
-// One JSON line per change of an output's raised state.
-void print_event(const PlantModel& plant, const GrangerMonitor& m, std::size_t k, std::size_t j) {
-  const LoopStats& l = m.loop(j);
-  std::string channel = "null", score = "null", p = "null";
-  bool by_gamma = false;
-  for (std::size_t i = 0; i < m.n_inputs(); ++i)
-    if (m.channel(j, i).alarm) {
-      channel = "\"" + plant.inputs[i] + "\"";
-      score = num(m.channel(j, i).score_conditional);
-      p = num(chi_square_survival(m.channel(j, i).score_conditional, static_cast<double>(m.settings().input_order)));
-      by_gamma = m.channel(j, i).located_by_gamma;
-    }
-  std::printf("{\"event\": \"%s\", \"sample\": %zu, \"output\": \"%s\", \"channel\": %s, \"statistic\": %s, "
-              "\"threshold\": %s, \"window\": %s, \"p_value\": %s, \"conditional_score\": %s, \"by_gamma\": %s, "
-              "\"physics\": null}\n",
-              l.alarm ? "raised" : "cleared", k, plant.outputs[j].c_str(), channel.c_str(), num(l.score).c_str(),
-              num(l.score_threshold).c_str(), num(l.score_window).c_str(),
-              num(chi_square_survival(l.score, static_cast<double>(m.n_inputs() * static_cast<std::size_t>(m.settings().input_order)))).c_str(),
-              score.c_str(), by_gamma ? "true" : "false");
+// A JSON number to full precision, or null.
+std::string exact(double v) {
+  if (!std::isfinite(v)) return "null";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+// One JSON line per raise or clear of a channel: the edges mpmd publishes as
+// alarm messages for the same samples, with the same numbers (AlarmEdges,
+// alarm_facts in core/monitor_front_end.hpp).
+void print_event(const PlantModel& plant, const GrangerMonitor& m, std::size_t k, std::size_t j, std::size_t i) {
+  const AlarmFacts f = alarm_facts(m, j, i);
+  std::printf("{\"event\": \"%s\", \"sample\": %zu, \"output\": \"%s\", \"channel\": \"%s\", \"statistic\": %s, "
+              "\"threshold\": %s, \"window\": %s, \"p_value\": %s, \"F_conditional\": %s, \"gamma\": %s, "
+              "\"conditional_score\": %s, \"by_gamma\": %s, \"physics\": null}\n",
+              f.raised ? "raised" : "cleared", k, plant.outputs[j].c_str(), plant.inputs[i].c_str(),
+              exact(f.statistic).c_str(), exact(f.threshold).c_str(), exact(f.window).c_str(), exact(f.p_value).c_str(),
+              exact(f.f_conditional).c_str(), exact(f.gamma).c_str(), exact(f.conditional_score).c_str(),
+              f.by_gamma ? "true" : "false");
 }
 
 int run(int argc, char** argv) {
   try {
     const Args args(argc, argv, {"plant", "data", "ar-order", "input-order", "input-pole", "forgetting", "false-alarm", "threads",
-                     "false-alarms-per-year", "crossing-constant"},
+                     "false-alarms-per-year", "crossing-constant", "settle-samples"},
                     {"json", "events", "plain-lags", "help"});
     if (args.flag("help")) {
       std::fputs(kUsage, stdout);
@@ -149,50 +154,46 @@ int run(int argc, char** argv) {
     MonitorSettings settings;
     settings.ar_order = args.integer("ar-order", settings.ar_order);
     settings.input_order = args.integer("input-order", settings.input_order);
-    settings.forgetting = args.number("forgetting", 1.0);
+    settings.forgetting = args.number("forgetting", kRecordForgetting);
     settings.false_alarm = args.number("false-alarm", settings.false_alarm);
     settings.detector.false_alarms_per_year =
         args.number("false-alarms-per-year", settings.detector.false_alarms_per_year);
     settings.detector.crossing_constant = args.number("crossing-constant", settings.detector.crossing_constant);
     const PlantModel plant = config::load_plant(args.required("plant"));
     const std::string pole = args.get("input-pole").value_or("0");
-    settings.input_pole = pole == "auto" ? dominant_pole(plant) : args.number("input-pole", 0.0);
+    settings.input_pole = pole == "auto" ? dominant_pole(plant) : args.number("input-pole", settings.input_pole);
     if (const std::string e = settings.validate(); !e.empty()) throw UsageError(e);
     const int requested_threads = args.integer("threads", 0);  // 0: one per core
     if (args.get("threads") && requested_threads < 1) throw UsageError("--threads must be >= 1");
+    const int settle = args.integer("settle-samples", -1);  // -1: settle_length's automatic rule
+    if (settle < -1) throw UsageError("--settle-samples must be >= 0 (or -1: automatic)");
 
     std::vector<ChannelTrace> trace(plant.n_inputs() * plant.n_outputs());
-    std::vector<char> raised(plant.n_outputs(), 0);
+    AlarmEdges edges(plant.n_outputs(), plant.n_inputs());
     // On each part's thread: only its outputs, so the parts write disjoint traces.
     const bool events = args.flag("events");
     if (events && requested_threads > 1) throw UsageError("--events needs one thread (events in sample order)");
     const PartSampleCallback on_sample = [&](std::size_t k, const GrangerMonitor& m) {
-      for (std::size_t j = m.first_modelled_output(); j < m.end_modelled_output(); ++j) {
-        if (m.loop(j).alarm != (raised[j] != 0)) {
-          raised[j] = m.loop(j).alarm ? 1 : 0;
-          if (events) print_event(plant, m, k, j);
-        }
-        for (std::size_t i = 0; i < m.n_inputs(); ++i) {
-          ChannelTrace& t = trace[j * m.n_inputs() + i];
-          const bool now = m.channel(j, i).alarm;
-          if (now && !t.was_alarm && t.raised_at < 0) t.raised_at = static_cast<long>(k);
-          if (!now && t.was_alarm) t.cleared_at = static_cast<long>(k);
-          t.was_alarm = now;
-        }
-      }
+      edges.scan(m, m.first_modelled_output(), m.end_modelled_output(), [&](std::size_t j, std::size_t i, bool now) {
+        ChannelTrace& t = trace[j * m.n_inputs() + i];
+        if (now && t.raised_at < 0) t.raised_at = static_cast<long>(k);
+        if (!now) t.cleared_at = static_cast<long>(k);
+        if (events) print_event(plant, m, k, j, i);
+      });
     };
     // By default the recording is streamed (memory independent of its
     // length); --threads N > 1 loads it whole and splits the outputs.
     std::size_t samples = 0, transient = 0;
     const GrangerMonitor monitor = [&] {
       if (requested_threads <= 1) {
-        StreamedRecord r = monitor_csv_stream(plant, args.required("data"), settings, args.flag("plain-lags"), on_sample);
+        StreamedRecord r =
+            monitor_csv_stream(plant, args.required("data"), settings, args.flag("plain-lags"), on_sample, settle);
         samples = r.samples;
         transient = r.transient;
         return std::move(r.monitor);
       }
       const config::Recording rec = config::load_recording(args.required("data"));
-      const ResidualSeries series = compute_residuals(plant, rec, config::bind(plant, rec));
+      const ResidualSeries series = compute_residuals(plant, rec, config::bind(plant, rec), settle);
       samples = rec.samples();
       transient = series.transient;
       return monitor_record(plant, series, settings, static_cast<std::size_t>(requested_threads),

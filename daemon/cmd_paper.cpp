@@ -7,6 +7,7 @@
 #include <string>
 
 #include "config/output_file.hpp"
+#include "core/monitor_front_end.hpp"
 #include "daemon/args.hpp"
 #include "daemon/command.hpp"
 #include "daemon/paper_cases.hpp"
@@ -75,7 +76,7 @@ int run(int argc, char** argv) {
     MonitorSettings settings;  // whole record (lambda = 1)
     settings.input_order = args.integer("input-order", settings.input_order);
     settings.ar_order = args.integer("ar-order", settings.ar_order);
-    settings.forgetting = 1.0;
+    settings.forgetting = kRecordForgetting;
     std::printf("mpm paper: online monitor na=%d nb=%d, conditional LR test at alpha=%g per channel "
                 "(* = significant, (g) = located by gamma); F = paper's pairwise index, g = gamma (noise-model index)\n",
                 settings.ar_order, settings.input_order, settings.false_alarm);

@@ -1,17 +1,12 @@
 #include "daemon/offline.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <stdexcept>
 #include <thread>
-
-#include "core/mimo_model.hpp"
-#include "core/noise_filter.hpp"
 
 namespace mpm {
 
 ResidualSeries compute_residuals(const PlantModel& plant, const config::Recording& rec,
-                                 const config::BoundRecording& bound) {
+                                 const config::BoundRecording& bound, int settle_samples) {
   const auto n = static_cast<Eigen::Index>(rec.samples());
   const auto m = static_cast<Eigen::Index>(plant.n_inputs());
   const auto p = static_cast<Eigen::Index>(plant.n_outputs());
@@ -19,101 +14,31 @@ ResidualSeries compute_residuals(const PlantModel& plant, const config::Recordin
   s.u.resize(n, m);
   s.residual.resize(n, p);
   for (Eigen::Index i = 0; i < m; ++i) s.u.col(i) = rec.data.col(static_cast<Eigen::Index>(bound.inputs[static_cast<std::size_t>(i)]));
-
-  std::vector<double> u0(plant.n_inputs(), 0.0);
-  if (plant.operating_point) {
-    u0 = plant.operating_point->inputs;
-  } else {
-    for (Eigen::Index k = 0; k < n; ++k)
-      if (s.u.row(k).allFinite()) {
-        for (Eigen::Index i = 0; i < m; ++i) u0[static_cast<std::size_t>(i)] = s.u(k, i);
-        break;
-      }
-  }
-  ResidualGenerator gen(plant, u0);
-  std::vector<double> y(plant.n_outputs()), r(plant.n_outputs());
   bool all_sim = true;
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const Eigen::VectorXd u = s.u.row(k).transpose();
-    for (Eigen::Index j = 0; j < p; ++j) y[static_cast<std::size_t>(j)] = rec.data(k, static_cast<Eigen::Index>(bound.outputs[static_cast<std::size_t>(j)]));
-    gen.step(u.data(), y.data(), r.data());
-    for (Eigen::Index j = 0; j < p; ++j) {
-      const auto& sim = bound.sim[static_cast<std::size_t>(j)];
-      s.residual(k, j) = sim ? y[static_cast<std::size_t>(j)] - rec.data(k, static_cast<Eigen::Index>(*sim)) : r[static_cast<std::size_t>(j)];
-    }
-  }
   for (std::size_t j = 0; j < plant.n_outputs(); ++j) {
     s.from_simulation.push_back(bound.sim[j].has_value());
     all_sim = all_sim && bound.sim[j].has_value();
   }
-  // The user's simulation already accounts for the past; our model started
-  // from rest needs its transient discarded (at most a tenth of the record).
-  s.transient = all_sim ? 0 : settling_samples(plant, 0.01, static_cast<std::size_t>(n / 10));
+  s.transient = settle_length(plant, settle_samples, record_settle_cap(rec.samples()), all_sim);
+  // u0 from the whole record, so that every row has a residual.
+  ResidualFrontEnd front(plant, input_origin(plant, s.u), s.transient, s.from_simulation);
+  std::vector<double> u(plant.n_inputs()), y(plant.n_outputs()), sim_y(plant.n_outputs()), r(plant.n_outputs());
+  for (Eigen::Index k = 0; k < n; ++k) {
+    for (Eigen::Index i = 0; i < m; ++i) u[static_cast<std::size_t>(i)] = s.u(k, i);
+    for (Eigen::Index j = 0; j < p; ++j) {
+      const auto jj = static_cast<std::size_t>(j);
+      y[jj] = rec.data(k, static_cast<Eigen::Index>(bound.outputs[jj]));
+      sim_y[jj] = bound.sim[jj] ? rec.data(k, static_cast<Eigen::Index>(*bound.sim[jj])) : 0.0;
+    }
+    front.step(u.data(), y.data(), sim_y.data(), r.data());
+    for (Eigen::Index j = 0; j < p; ++j) s.residual(k, j) = r[static_cast<std::size_t>(j)];
+  }
   return s;
 }
 
-std::vector<std::optional<std::vector<double>>> noise_ar(const PlantModel& plant, int order) {
-  std::vector<std::optional<std::vector<double>>> out(plant.n_outputs());
-  for (std::size_t j = 0; j < plant.n_outputs(); ++j)
-    if (j < plant.noise.size() && plant.noise[j]) out[j] = inverse_noise_ar_coefficients(plant.noise[j]->tf, order);
-  return out;
-}
-
-RecordVerdict record_verdict(const GrangerMonitor& m) {
-  RecordVerdict v;
-  v.loop_mismatch.assign(m.n_outputs(), false);
-  v.by_gamma.assign(m.n_outputs() * m.n_inputs(), false);
-  const double limit = m.settings().gamma_lambda * m.settings().gamma_lambda;
-  for (std::size_t j = 0; j < m.n_outputs(); ++j) {
-    if (m.loop(j).diverging) {
-      v.diverging = true;
-      continue;
-    }
-    bool any = false;
-    for (std::size_t i = 0; i < m.n_inputs(); ++i)
-      if (m.channel(j, i).lr_conditional > m.raise_threshold()) {
-        v.located.emplace_back(j, i);
-        any = true;
-      }
-    if (!any && m.loop(j).lr_joint > m.joint_raise_threshold()) {
-      std::size_t best = m.n_inputs();
-      for (std::size_t i = 0; i < m.n_inputs(); ++i)
-        if (m.channel(j, i).gamma < limit &&
-            (best == m.n_inputs() || m.channel(j, i).f_pairwise > m.channel(j, best).f_pairwise))
-          best = i;
-      if (best < m.n_inputs()) {
-        v.located.emplace_back(j, best);
-        v.by_gamma[j * m.n_inputs() + best] = true;
-      }
-    }
-    v.loop_mismatch[j] = any || m.loop(j).lr_joint > m.joint_raise_threshold();
-  }
-  return v;
-}
-
-std::vector<std::optional<DiscreteTf>> channel_models(const PlantModel& plant) {
-  std::vector<std::optional<DiscreteTf>> out(plant.n_outputs() * plant.n_inputs());
-  for (const auto& c : plant.channels) out[c.output * plant.n_inputs() + c.input] = c.tf;
-  return out;
-}
-
-std::vector<double> reference_variances(const PlantModel& plant) {
-  std::vector<double> out(plant.n_outputs(), 0.0);
-  for (std::size_t j = 0; j < plant.n_outputs() && j < plant.noise.size(); ++j)
-    if (plant.noise[j] && plant.noise[j]->variance) out[j] = noise_output_variance(plant.noise[j]->tf, *plant.noise[j]->variance);
-  return out;
-}
-
-MonitorSettings for_plant(MonitorSettings settings, const PlantModel& plant) {
-  if (settings.detector.sample_time <= 0.0 && plant.sample_time > 0.0) settings.detector.sample_time = plant.sample_time;
-  return settings;
-}
-
 MonitorPartFactory monitor_factory(const PlantModel& plant, const MonitorSettings& settings, bool plain_lags) {
-  return [m = plant.n_inputs(), n = plant.n_outputs(), settings = for_plant(settings, plant), noise = noise_ar(plant, settings.ar_order),
-          reference = reference_variances(plant),
-          channels = plain_lags ? std::vector<std::optional<DiscreteTf>>{} : channel_models(plant)](OutputRange outputs) {
-    return GrangerMonitor(m, n, settings, noise, reference, channels, outputs);
+  return [blueprint = MonitorBlueprint(plant, settings, plain_lags)](OutputRange outputs) {
+    return blueprint.build(outputs);
   };
 }
 
@@ -172,41 +97,15 @@ GrangerMonitor monitor_record(const PlantModel& plant, const ResidualSeries& s, 
   return monitor;
 }
 
-diagnosis::Problem diagnosis_problem(const PlantModel& plant, const config::Recording& rec,
-                                     const config::BoundRecording& bound, const ResidualSeries& series,
-                                     const RecordVerdict& verdict) {
+diagnosis::Problem plant_problem(const PlantModel& plant, const Eigen::MatrixXd& u, const Eigen::MatrixXd& residual) {
   diagnosis::Problem p;
   p.inputs = plant.inputs;
   p.outputs = plant.outputs;
   p.sample_time = plant.sample_time;
-  const Eigen::Index n = series.u.rows(), m = series.u.cols();
-  // Deviation inputs as the residual generator sees them: u - u0, holding the
-  // last good value over missing samples.
-  std::vector<double> u0(static_cast<std::size_t>(m), 0.0);
-  if (plant.operating_point) {
-    u0 = plant.operating_point->inputs;
-  } else {
-    for (Eigen::Index k = 0; k < n; ++k)
-      if (series.u.row(k).allFinite()) {
-        for (Eigen::Index i = 0; i < m; ++i) u0[static_cast<std::size_t>(i)] = series.u(k, i);
-        break;
-      }
-  }
-  p.u_abs = series.u;
-  p.du.resize(n, m);
-  for (Eigen::Index i = 0; i < m; ++i) {
-    double last = u0[static_cast<std::size_t>(i)];
-    for (Eigen::Index k = 0; k < n; ++k) {
-      if (std::isfinite(series.u(k, i))) last = series.u(k, i);
-      p.du(k, i) = last - u0[static_cast<std::size_t>(i)];
-    }
-  }
-  p.residual = series.residual;
-  p.begin = series.transient;
-  for (std::size_t c : bound.extra) p.extra_names.push_back(rec.names[c]);
-  p.extra.resize(n, static_cast<Eigen::Index>(bound.extra.size()));
-  for (std::size_t c = 0; c < bound.extra.size(); ++c)
-    p.extra.col(static_cast<Eigen::Index>(c)) = rec.data.col(static_cast<Eigen::Index>(bound.extra[c]));
+  p.u_abs = u;
+  p.du = held_deviations(u, input_origin(plant, u));
+  p.residual = residual;
+  p.extra.resize(u.rows(), 0);
   p.nominal = channel_models(plant);
   p.noise.resize(plant.n_outputs());
   p.noise_variance.resize(plant.n_outputs());
@@ -215,6 +114,18 @@ diagnosis::Problem diagnosis_problem(const PlantModel& plant, const config::Reco
       p.noise[j] = plant.noise[j]->tf;
       p.noise_variance[j] = plant.noise[j]->variance;
     }
+  return p;
+}
+
+diagnosis::Problem diagnosis_problem(const PlantModel& plant, const config::Recording& rec,
+                                     const config::BoundRecording& bound, const ResidualSeries& series,
+                                     const RecordVerdict& verdict) {
+  diagnosis::Problem p = plant_problem(plant, series.u, series.residual);
+  p.begin = series.transient;
+  for (std::size_t c : bound.extra) p.extra_names.push_back(rec.names[c]);
+  p.extra.resize(series.u.rows(), static_cast<Eigen::Index>(bound.extra.size()));
+  for (std::size_t c = 0; c < bound.extra.size(); ++c)
+    p.extra.col(static_cast<Eigen::Index>(c)) = rec.data.col(static_cast<Eigen::Index>(bound.extra[c]));
   p.monitor_flag = verdict.loop_mismatch;
   p.monitor_located.resize(plant.n_outputs());
   for (const auto& [j, i] : verdict.located) p.monitor_located[j].push_back(i);

@@ -12,6 +12,7 @@
 #include "config/plant_loader.hpp"
 #include "core/diagnosis.hpp"
 #include "core/granger_monitor.hpp"
+#include "core/monitor_front_end.hpp"
 #include "core/plant_model.hpp"
 
 namespace mpm {
@@ -23,41 +24,15 @@ struct ResidualSeries {
   std::size_t transient = 0;  // leading samples that carry the model's start-up transient
 };
 
-// formats.md: u0 = operating_point.inputs, else the recording's first
-// complete input sample; the outputs' offset stays in the residual (the
-// monitor's intercept absorbs it).
+// The residuals of a whole recording by the front end mpmd uses
+// (core/monitor_front_end.hpp): u0 by its rule (the operating point, else
+// the recording's first complete input row), y - sim_y for the outputs with
+// a sim_ column, and the settle time (`settle_samples` >= 0: that many;
+// else none when every output has a sim_ column, else the plant's settling
+// time capped at a tenth of the record). The outputs' offset stays in the
+// residual (the monitor's intercept absorbs it).
 ResidualSeries compute_residuals(const PlantModel& plant, const config::Recording& rec,
-                                 const config::BoundRecording& bound);
-
-// Noise-model AR coefficients (1 - N^-1) per output, for the gamma index.
-std::vector<std::optional<std::vector<double>>> noise_ar(const PlantModel& plant, int order);
-
-// The settings with what the plant file knows filled in: the detector's
-// sample time (0 in the settings = the plant's).
-MonitorSettings for_plant(MonitorSettings settings, const PlantModel& plant);
-
-// Variance of each output's residual with a matched model (N's output
-// variance), 0 where the plant file gives no noise model or no variance.
-std::vector<double> reference_variances(const PlantModel& plant);
-
-// The nominal channels G_ji, output major, for the monitor's model-filtered
-// regressors (nullopt where the model has no channel).
-std::vector<std::optional<DiscreteTf>> channel_models(const PlantModel& plant);
-
-// The verdict on a whole record, from the statistics after its last sample
-// (with forgetting 1 they summarise the whole record; the alarm state with
-// its hysteresis is for live use): a channel is located when its own
-// conditional test rejects at the monitor's alpha; in a loop where none does
-// but the joint test of all inputs rejects, the paper's two indices name the
-// channel: among those whose AR part matches N^-1 (gamma < lambda^2), the
-// one with the largest pairwise F. Diverging loops locate nothing.
-struct RecordVerdict {
-  std::vector<std::pair<std::size_t, std::size_t>> located;  // (output, input), row major
-  std::vector<bool> loop_mismatch;                           // per output
-  std::vector<bool> by_gamma;                                // per channel, output major
-  bool diverging = false;
-};
-RecordVerdict record_verdict(const GrangerMonitor& monitor);
+                                 const config::BoundRecording& bound, int settle_samples = -1);
 
 // Runs the online monitor over the series (after the transient), calling
 // `on_sample(k, monitor)` after each update when given.
@@ -72,10 +47,14 @@ void run_monitor(GrangerMonitor& monitor, const ResidualSeries& s, OnSample&& on
   }
 }
 
-// What `mpm diagnose` hands to the hypothesis fits (core/diagnosis.hpp):
-// deviation inputs (the last good value held over missing samples), the
-// residual series, the recording's extra columns, the plant's channels and
-// noise models, and the monitor's verdict on the record.
+// What every diagnosis hands to the hypothesis fits (core/diagnosis.hpp)
+// from a plant and a window of samples (samples x inputs, absolute units;
+// samples x outputs): the deviation inputs of the front end (u0 by its rule,
+// the last good value held over missing samples), the residuals, the plant's
+// channels and noise models; no extra columns, no monitor verdict.
+diagnosis::Problem plant_problem(const PlantModel& plant, const Eigen::MatrixXd& u, const Eigen::MatrixXd& residual);
+// What `mpm diagnose` hands to them: the plant problem of the recording, its
+// extra columns, and the monitor's verdict on the record.
 diagnosis::Problem diagnosis_problem(const PlantModel& plant, const config::Recording& rec,
                                      const config::BoundRecording& bound, const ResidualSeries& series,
                                      const RecordVerdict& verdict);
@@ -87,8 +66,7 @@ using MonitorPartFactory = std::function<GrangerMonitor(OutputRange)>;
 // end_modelled_output()) are meaningful in it.
 using PartSampleCallback = std::function<void(std::size_t, const GrangerMonitor&)>;
 
-// Monitors of `plant` with `settings`: its noise models (for gamma) and
-// reference variances, and model-filtered regressors unless `plain_lags`.
+// Parts of the monitor the blueprint builds (core/monitor_front_end.hpp).
 MonitorPartFactory monitor_factory(const PlantModel& plant, const MonitorSettings& settings, bool plain_lags = false);
 
 // Threads worth using for a monitor of `outputs` outputs on this machine:

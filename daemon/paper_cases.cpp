@@ -48,10 +48,7 @@ PaperCaseResult run_paper_case(const std::string& scenario, std::uint64_t seed, 
 
   const config::BoundRecording bound = config::bind(plant, rec);
   const ResidualSeries series = compute_residuals(plant, rec, bound);
-  PaperCaseResult out{plant, GrangerMonitor(plant.n_inputs(), plant.n_outputs(), for_plant(settings, plant),
-                                            noise_ar(plant, settings.ar_order), reference_variances(plant),
-                                            channel_models(plant)),
-                      {}, {}, {}, false, rec.samples()};
+  PaperCaseResult out{plant, MonitorBlueprint(plant, settings).build(), {}, {}, {}, false, rec.samples()};
   run_monitor(out.monitor, series, [](std::size_t, const GrangerMonitor&) {});
   const RecordVerdict verdict = record_verdict(out.monitor);
   out.located = verdict.located;

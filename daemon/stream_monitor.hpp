@@ -1,9 +1,9 @@
 // `mpm monitor` over a recording read as a stream (config/csv_stream.hpp):
 // memory independent of the record's length. Two passes over the file: the
 // first checks the time column and finds what compute_residuals needs from
-// the whole record (u0 = the first complete input sample, the sample count
-// that caps the transient), the second computes each residual and updates
-// the monitor at once. The same residuals and, with the monitor updated on
+// the whole record (u0 by the front end's rule, the sample count that caps
+// the settle time), the second computes each residual by the front end
+// (core/monitor_front_end.hpp) and updates the monitor at once. The same residuals and, with the monitor updated on
 // one thread, the same statistics as compute_residuals + monitor_record,
 // which are bit for bit those of its parallel replay (offline.hpp).
 #pragma once
@@ -15,7 +15,7 @@
 
 #include "config/csv_stream.hpp"
 #include "config/plant_loader.hpp"
-#include "core/mimo_model.hpp"
+#include "core/monitor_front_end.hpp"
 #include "daemon/offline.hpp"
 
 namespace mpm {
@@ -28,7 +28,7 @@ struct StreamedRecord {
 
 inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::string& path,
                                          const MonitorSettings& settings, bool plain_lags,
-                                         const PartSampleCallback& on_sample) {
+                                         const PartSampleCallback& on_sample, int settle_samples = -1) {
   // Column indices and names as bind() gives them (its time check runs on
   // the rows below, with the same message).
   config::Recording header;
@@ -43,9 +43,8 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
   }
   const std::size_t m = plant.n_inputs(), p = plant.n_outputs();
   const double ts = plant.sample_time;
-  std::vector<double> u0(m, 0.0);
-  bool have_u0 = plant.operating_point.has_value();
-  if (have_u0) u0 = plant.operating_point->inputs;
+  InputOrigin origin(plant);
+  std::vector<double> u(m), y(p), sim_y(p), d(p);
   std::size_t n = 0;
   {
     config::CsvRowReader reader(path);
@@ -66,30 +65,30 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
         }
       }
       last_t = t;
-      if (!have_u0) {
-        bool complete = true;
-        for (std::size_t i = 0; i < m; ++i) complete = complete && std::isfinite(row[bound.inputs[i]]);
-        if (complete) {
-          for (std::size_t i = 0; i < m; ++i) u0[i] = row[bound.inputs[i]];
-          have_u0 = true;
-        }
+      if (!origin.known()) {
+        for (std::size_t i = 0; i < m; ++i) u[i] = row[bound.inputs[i]];
+        origin.offer(u.data());
       }
       ++n;
     }
   }
   bool all_sim = true;
-  for (std::size_t j = 0; j < p; ++j) all_sim = all_sim && bound.sim[j].has_value();
-  StreamedRecord out{monitor_factory(plant, settings, plain_lags)(OutputRange{}), n,
-                     all_sim ? 0 : settling_samples(plant, 0.01, n / 10)};
-  ResidualGenerator gen(plant, u0);
-  std::vector<double> u(m), y(p), r(p), d(p);
+  std::vector<bool> use_sim(p);
+  for (std::size_t j = 0; j < p; ++j) {
+    use_sim[j] = bound.sim[j].has_value();
+    all_sim = all_sim && use_sim[j];
+  }
+  const std::size_t settle = settle_length(plant, settle_samples, record_settle_cap(n), all_sim);
+  StreamedRecord out{MonitorBlueprint(plant, settings, plain_lags).build(), n, settle};
+  ResidualFrontEnd front(plant, origin.u0(), settle, std::move(use_sim));
   config::CsvRowReader reader(path);
   for (std::size_t k = 0; reader.next(row); ++k) {
     for (std::size_t i = 0; i < m; ++i) u[i] = row[bound.inputs[i]];
-    for (std::size_t j = 0; j < p; ++j) y[j] = row[bound.outputs[j]];
-    gen.step(u.data(), y.data(), r.data());
-    for (std::size_t j = 0; j < p; ++j) d[j] = bound.sim[j] ? y[j] - row[*bound.sim[j]] : r[j];
-    if (k < out.transient) continue;
+    for (std::size_t j = 0; j < p; ++j) {
+      y[j] = row[bound.outputs[j]];
+      sim_y[j] = bound.sim[j] ? row[*bound.sim[j]] : 0.0;
+    }
+    if (front.step(u.data(), y.data(), sim_y.data(), d.data()) != ResidualFrontEnd::Stage::kReady) continue;
     out.monitor.update(u.data(), d.data());
     if (on_sample) on_sample(k, out.monitor);
   }

@@ -146,45 +146,12 @@ msg::Diagnosis DiagnosisWorker::diagnose(const PlantModel& plant, const std::vec
   d.input_index = static_cast<std::int32_t>(r.input);
   d.window = static_cast<std::int32_t>(u.rows());
 
-  // The problem `mpm diagnose` builds from a recording (daemon/offline.cpp),
-  // from the window: u0 = the operating point, else the window's first
-  // complete input sample; missing inputs hold their last value.
-  diagnosis::Problem problem;
-  problem.inputs = plant.inputs;
-  problem.outputs = plant.outputs;
-  problem.sample_time = plant.sample_time;
-  const Eigen::Index n = u.rows(), m = u.cols();
-  Eigen::VectorXd u0 = Eigen::VectorXd::Zero(m);
-  if (plant.operating_point) {
-    for (Eigen::Index i = 0; i < m; ++i) u0(i) = plant.operating_point->inputs[static_cast<std::size_t>(i)];
-  } else {
-    for (Eigen::Index k = 0; k < n; ++k) {
-      if (u.row(k).allFinite()) {
-        u0 = u.row(k).transpose();
-        break;
-      }
-    }
-  }
-  problem.u_abs = u;
-  problem.du.resize(n, m);
-  for (Eigen::Index i = 0; i < m; ++i) {
-    double last = u0(i);
-    for (Eigen::Index k = 0; k < n; ++k) {
-      if (std::isfinite(u(k, i))) last = u(k, i);
-      problem.du(k, i) = last - u0(i);
-    }
-  }
-  problem.residual = residual;
-  problem.extra.resize(n, 0);
-  problem.nominal = nominal;
-  problem.noise.resize(plant.n_outputs());
-  problem.noise_variance.resize(plant.n_outputs());
-  for (std::size_t j = 0; j < plant.n_outputs() && j < plant.noise.size(); ++j) {
-    if (plant.noise[j]) {
-      problem.noise[j] = plant.noise[j]->tf;
-      problem.noise_variance[j] = plant.noise[j]->variance;
-    }
-  }
+  // The problem `mpm diagnose` builds from a recording (daemon/offline.hpp),
+  // from the window, by the same front end (u0 = the operating point, else
+  // the window's first complete input sample; missing inputs hold their
+  // last value).
+  diagnosis::Problem problem = plant_problem(plant, u, residual);
+  problem.nominal = nominal;  // computed once, at setup
   problem.monitor_flag.assign(plant.n_outputs(), false);
   problem.monitor_flag[r.output] = true;
   problem.monitor_located.resize(plant.n_outputs());

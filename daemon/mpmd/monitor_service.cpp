@@ -6,17 +6,12 @@
 #include <cstdio>
 #include <limits>
 
-#include "core/chi_square.hpp"
-#include "daemon/offline.hpp"
 #include "daemon/mpmd/log.hpp"
 
 namespace mpm {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// The automatic settle time is the plant's 1% settling time, capped: an
-// integrating channel never settles.
-constexpr std::size_t kSettleCap = 2000;
 // A gap longer than this restarts the settle time: the model held the last
 // input through it while the plant saw the real ones, and that error decays
 // like a start-up transient. Shorter gaps leave a negligible error.
@@ -57,23 +52,18 @@ MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& s
     : plant_(plant),
       settings_(settings),
       on_alarm_(std::move(on_alarm)),
-      // The same monitor as `mpm monitor` builds offline (daemon/offline.hpp).
-      monitor_(plant.n_inputs(), plant.n_outputs(), for_plant(settings.monitor, plant), noise_ar(plant, settings.monitor.ar_order),
-               reference_variances(plant),
-               settings.plain_lags ? std::vector<std::optional<DiscreteTf>>{} : channel_models(plant)),
+      // The same monitor and front end as `mpm monitor` builds offline.
+      monitor_(MonitorBlueprint(plant, settings.monitor, settings.plain_lags).build()),
+      front_(plant, settle_length(plant, settings.settle_samples, kLiveSettleCap)),
       tracker_(settings.max_sequence_jump),
       residual_(plant.n_outputs(), 0.0),
       nan_u_(plant.n_inputs(), kNaN),
       nan_y_(plant.n_outputs(), kNaN),
-      alarm_state_(plant.n_inputs() * plant.n_outputs(), 0),
+      edges_(plant.n_outputs(), plant.n_inputs()),
       physics_(plant.n_inputs() * plant.n_outputs()) {
   if (settings.diagnosis_window > 0) {
     diagnosis_ = std::make_unique<DiagnosisWorker>(plant, static_cast<std::size_t>(settings.diagnosis_window));
   }
-  settle_ = settings.settle_samples >= 0 ? settings.settle_samples
-                                         : static_cast<int>(settling_samples(plant, 0.01, kSettleCap));
-  settling_ = settle_;
-  if (plant.operating_point) residuals_.emplace(plant, plant.operating_point->inputs);
   const auto interval = seconds(settings.log_interval);
   const double auto_stale = std::max(60.0, 10.0 * plant.sample_time);
   stale_after_ = seconds(settings.stale_after < 0 ? auto_stale : settings.stale_after);
@@ -144,44 +134,30 @@ bool MonitorService::sized_right(const msg::Sample& s) const noexcept {
 void MonitorService::skip_missing(std::int64_t count) noexcept {
   const std::int64_t fill = count < kMaxGapFill ? count : kMaxGapFill;
   for (std::int64_t k = 0; k < fill; ++k) step(nan_u_.data(), nan_y_.data(), nullptr);
-  if (count > kResettleGap) settling_ = settle_;
+  if (count > kResettleGap) front_.resettle();
 }
 
 // Residual of one sample (NaN where values are missing), then the monitor.
 void MonitorService::step(const double* u, const double* y, const double* sim_y) noexcept {
-  if (!residuals_) {
-    bool complete = true;
-    for (std::size_t i = 0; i < plant_.n_inputs(); ++i) complete = complete && std::isfinite(u[i]);
-    if (!complete) return;  // no operating point yet: wait for a complete input sample
-    // formats.md: without an operating point, the first complete input sample
-    // is u0. Happens once per service (setup allocation, not per sample).
-    residuals_.emplace(plant_, std::vector<double>(u, u + plant_.n_inputs()));
-  }
-  residuals_->step(u, y, residual_.data());
-  if (sim_y != nullptr) {
-    for (std::size_t j = 0; j < plant_.n_outputs(); ++j) residual_[j] = y[j] - sim_y[j];
-  }
-  if (settling_ > 0) {
-    --settling_;
-    if (diagnosis_) diagnosis_->record(u, nan_y_.data());  // the transient is not evidence
-    return;
+  switch (front_.step(u, y, sim_y, residual_.data())) {
+    case ResidualFrontEnd::Stage::kNoOrigin:
+      return;  // no operating point yet: waits for a complete input sample
+    case ResidualFrontEnd::Stage::kSettling:
+      if (diagnosis_) diagnosis_->record(u, nan_y_.data());  // the transient is not evidence
+      return;
+    case ResidualFrontEnd::Stage::kReady:
+      break;
   }
   if (diagnosis_) diagnosis_->record(u, residual_.data());
   monitor_.update(u, residual_.data());
 }
 
 void MonitorService::check_alarms(const msg::Sample& s) {
-  const std::size_t n_in = plant_.n_inputs();
-  for (std::size_t j = 0; j < plant_.n_outputs(); ++j) {
-    for (std::size_t i = 0; i < n_in; ++i) {
-      const std::uint8_t now = monitor_.channel(j, i).alarm ? 1 : 0;
-      if (now == alarm_state_[j * n_in + i]) continue;
-      alarm_state_[j * n_in + i] = now;
-      if (now) physics_[j * n_in + i].clear();  // a new episode: its physics is not known yet
-      publish_alarm(j, i, s);
-      if (now && diagnosis_) diagnosis_->request({j, i, alarm_.utime, s.seq, settings_.controller_id});
-    }
-  }
+  edges_.scan(monitor_, [&](std::size_t j, std::size_t i, bool raised) {
+    if (raised) physics_[j * plant_.n_inputs() + i].clear();  // a new episode: its physics is not known yet
+    publish_alarm(j, i, s);
+    if (raised && diagnosis_) diagnosis_->request({j, i, alarm_.utime, s.seq, settings_.controller_id});
+  });
 }
 
 void MonitorService::fill_alarm_header(std::size_t output, std::size_t input, std::int64_t utime, std::int64_t seq) {
@@ -199,7 +175,7 @@ void MonitorService::republish_raised(const std::string& reason) {
   const std::size_t n_in = plant_.n_inputs();
   for (std::size_t j = 0; j < plant_.n_outputs(); ++j) {
     for (std::size_t i = 0; i < n_in; ++i) {
-      if (!alarm_state_[j * n_in + i]) continue;
+      if (!edges_.raised(j, i)) continue;
       const ChannelStats& c = monitor_.channel(j, i);
       fill_alarm_header(j, i, 0, tracker_.last());
       alarm_.raised = true;
@@ -219,8 +195,8 @@ void MonitorService::retire(const std::string& reason) {
   const std::size_t n_in = plant_.n_inputs();
   for (std::size_t j = 0; j < plant_.n_outputs(); ++j) {
     for (std::size_t i = 0; i < n_in; ++i) {
-      if (!alarm_state_[j * n_in + i]) continue;
-      alarm_state_[j * n_in + i] = 0;
+      if (!edges_.raised(j, i)) continue;
+      edges_.lower(j, i);
       const ChannelStats& c = monitor_.channel(j, i);
       fill_alarm_header(j, i, 0, tracker_.last());
       alarm_.raised = false;
@@ -237,32 +213,32 @@ void MonitorService::retire(const std::string& reason) {
 }
 
 void MonitorService::publish_alarm(std::size_t output, std::size_t input, const msg::Sample& s) {
-  const ChannelStats& c = monitor_.channel(output, input);
+  const AlarmFacts f = alarm_facts(monitor_, output, input);
   fill_alarm_header(output, input, s.utime, s.seq);
-  alarm_.raised = c.alarm;
-  alarm_.f = c.f_conditional;
-  alarm_.p_value = monitor_.p_value(c.lr_conditional);
-  alarm_.gamma = c.gamma;
+  alarm_.raised = f.raised;
+  alarm_.f = f.f_conditional;
+  alarm_.p_value = f.p_value;
+  alarm_.gamma = f.gamma;
   // Known once the diagnosis that a raise asks for has finished: empty in the
   // raise itself (the diagnosis message follows it), filled in later alarms.
   alarm_.physics = physics_[output * plant_.n_inputs() + input];
-  char text[256];
-  const LoopStats& l = monitor_.loop(output);
-  if (c.alarm) {
+  char text[320];
+  if (f.raised) {
     // The output's sequential detector raised; this channel has the best
-    // evidence (its conditional score, or the paper's gamma rule).
-    alarm_.p_value = chi_square_survival(c.score_conditional, static_cast<double>(monitor_.settings().input_order));
+    // evidence (its conditional score, or the paper's gamma rule). The
+    // statistic and threshold to 10 digits: what `mpm monitor --events`
+    // prints for the same samples (tests/daemon/loopback_events_test.cpp).
     std::snprintf(text, sizeof text,
-                  "model-plant mismatch on %s -> %s: score %.1f > %.1f over %.0f samples, conditional score %.1f "
+                  "model-plant mismatch on %s -> %s: score %.10g > %.10g over %.0f samples, conditional score %.1f "
                   "(p=%.2g)%s, gamma=%.3g",
-                  alarm_.input.c_str(), alarm_.output.c_str(), l.score, l.score_threshold, l.score_window,
-                  c.score_conditional, alarm_.p_value, c.located_by_gamma ? " named by gamma" : "", c.gamma);
+                  alarm_.input.c_str(), alarm_.output.c_str(), f.statistic, f.threshold, f.window,
+                  f.conditional_score, f.p_value, f.by_gamma ? " named by gamma" : "", f.gamma);
   } else {
     std::snprintf(text, sizeof text, "cleared: %s -> %s agrees with the model again: F=%.4g",
-                  alarm_.input.c_str(), alarm_.output.c_str(), c.f_conditional);
+                  alarm_.input.c_str(), alarm_.output.c_str(), f.f_conditional);
   }
   alarm_.text = text;
-  log::write(c.alarm ? log::Level::kWarning : log::Level::kNotice, "controller '%s': %s (sample %" PRId64 ")",
+  log::write(f.raised ? log::Level::kWarning : log::Level::kNotice, "controller '%s': %s (sample %" PRId64 ")",
              settings_.controller_id.c_str(), text, s.seq);
   if (on_alarm_) on_alarm_(alarm_);
 }

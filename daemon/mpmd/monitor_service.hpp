@@ -9,9 +9,11 @@
 // sample counts as malformed and never touches the sequence or session state)
 // -> sequence check (duplicates and out-of-order samples dropped, gaps filled
 // with missing samples so the model's time stays aligned, implausible jumps
-// resynchronised) -> residual (y - sim_y when the sample
-// carries the controller's prediction, else y - G_M (u - u0)) -> monitor
-// update -> alarm edges. Every anomaly is counted for the status and logged
+// resynchronised) -> residual by the front end `mpm monitor` uses offline
+// (core/monitor_front_end.hpp: u0, y - sim_y when the sample carries the
+// controller's prediction, else y - G_M (u - u0), settling) -> monitor
+// update -> alarm edges (AlarmEdges, alarm_facts: what `mpm monitor
+// --events` prints). Every anomaly is counted for the status and logged
 // through a Throttle (first at once, then at most once per log interval).
 //
 // Allocation: setup allocates; on_sample allocates nothing in steady state.
@@ -27,6 +29,7 @@
 
 #include "core/granger_monitor.hpp"
 #include "core/mimo_model.hpp"
+#include "core/monitor_front_end.hpp"
 #include "core/plant_model.hpp"
 #include "daemon/mpmd/diagnosis_worker.hpp"
 #include "daemon/mpmd/sequence_tracker.hpp"
@@ -42,7 +45,8 @@ struct ServiceSettings {
   // filtered through the nominal channel (what `mpm monitor` does by default).
   bool plain_lags = false;
   // Samples skipped after the nominal model starts (or restarts after a long
-  // gap) while its start-up transient decays; -1 = the plant's settling time.
+  // gap) while its start-up transient decays; -1 = the plant's settling time
+  // (settle_length with kLiveSettleCap). `mpm monitor --settle-samples`.
   int settle_samples = -1;
   double log_interval = 60.0;  // seconds between repeats of one kind of log line
   // Largest sequence gap (or step back) taken as plausible; beyond it the
@@ -110,7 +114,7 @@ class MonitorService {
   const GrangerMonitor& monitor() const noexcept { return monitor_; }
   const PlantModel& plant() const noexcept { return plant_; }
   const ServiceSettings& settings() const noexcept { return settings_; }
-  int settle_samples() const noexcept { return settle_; }
+  int settle_samples() const noexcept { return front_.settle(); }
   std::int64_t last_sequence() const noexcept { return tracker_.last(); }
   const AlarmSink& alarm_sink() const noexcept { return on_alarm_; }
 
@@ -134,19 +138,15 @@ class MonitorService {
   void republish_raised(const std::string& reason);
 
   // Calls v(member) for everything that changes after setup (checkpoint.hpp):
-  // the residual model (made at the first complete sample when the plant
-  // file gives no operating point), the sequence, counters, settling and
-  // alarm states, and the monitor. Throttles start afresh.
+  // the residual model (its u0 found at the first complete sample when the
+  // plant file gives no operating point), the sequence, counters, settling
+  // and alarm states, and the monitor. Throttles start afresh.
   template <class V>
   void visit_state(V&& v) {
-    bool has_residuals = residuals_.has_value();
-    v(has_residuals);
-    // When reading, the residual model is first built with u0 = 0 so the
-    // visitor has an object to fill; its saved state, u0 included, replaces it.
-    if (has_residuals && !residuals_) residuals_.emplace(plant_, std::vector<double>(plant_.n_inputs(), 0.0));
-    if (!has_residuals) residuals_.reset();
-    if (residuals_) v(*residuals_);
-    v(tracker_); v(counters_); v(settling_); v(alarm_state_); v(monitor_);
+    front_.visit_model(v);
+    v(tracker_); v(counters_);
+    front_.visit_settling(v);
+    v(edges_); v(monitor_);
   }
 
  private:
@@ -164,7 +164,7 @@ class MonitorService {
   ServiceSettings settings_;
   AlarmSink on_alarm_;
   GrangerMonitor monitor_;
-  std::optional<ResidualGenerator> residuals_;  // made at the first complete input sample
+  ResidualFrontEnd front_;
   SequenceTracker tracker_;
   ServiceCounters counters_;
   std::uint64_t malformed_pending_ = 0;  // malformed since the last accepted sample: not gaps
@@ -172,11 +172,9 @@ class MonitorService {
   std::optional<Clock::time_point> last_usable_;    // last sample that reached the model, finite
   std::optional<Clock::time_point> watch_start_;    // first check_health: the clock before any sample
   bool stale_ = false;
-  int settle_ = 0;       // samples to skip after a (re)start of the model
-  int settling_ = 0;     // of those, still to skip
   std::vector<double> residual_;
   std::vector<double> nan_u_, nan_y_;        // a missing sample
-  std::vector<std::uint8_t> alarm_state_;    // output-major, as published
+  AlarmEdges edges_;                         // as published
   msg::Alarm alarm_;
   std::unique_ptr<DiagnosisWorker> diagnosis_;  // null when diagnosis_window = 0
   std::vector<std::string> physics_;           // per channel: the last diagnosis' physics word
