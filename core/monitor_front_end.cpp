@@ -1,5 +1,6 @@
 #include "core/monitor_front_end.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
