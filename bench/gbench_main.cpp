@@ -12,7 +12,7 @@
 #include "bench/replay.hpp"
 #include "bench/workload.hpp"
 #include "core/bierman_rls.hpp"
-#include "core/sqrt_rls.hpp"
+#include "tests/support/sqrt_rls.hpp"
 #include "core/ud_rls.hpp"
 
 namespace mpm::bench {
