@@ -179,9 +179,9 @@ constexpr void for_each_field(F&& f) {
 }
 
 #define MPM_GET(member) [](auto& m) -> auto& { return m.member; }
-#define MPM_SCALAR(member, ...) f(Scalar{Names{#member, __VA_ARGS__}, MPM_GET(member)})
+#define MPM_SCALAR(member, ...) f(Scalar{Names{.name = #member, __VA_ARGS__}, MPM_GET(member)})
 #define MPM_ARRAY(member, ...) \
-  f(Array{Names{#member, __VA_ARGS__}, "n_" #member, MPM_GET(member), MPM_GET(n_##member)})
+  f(Array{Names{.name = #member, __VA_ARGS__}, "n_" #member, MPM_GET(member), MPM_GET(n_##member)})
 #define MPM_NAMED_VALUES(names_, values_, length_, dds_)                                                   \
   f(NamedValues{#names_, #values_, #length_, #dds_, #dds_, MPM_GET(names_), MPM_GET(values_), MPM_GET(length_), \
                 MPM_GET(dds_)})
@@ -193,7 +193,7 @@ struct Fields<Sample> {
   static constexpr const char* json_type = "sample";
   template <class F>
   static constexpr void visit(F& f) {
-    MPM_SCALAR(controller_id, "controller", true);
+    MPM_SCALAR(controller_id, .json = "controller", .key = true);
     MPM_SCALAR(session_id);
     MPM_SCALAR(seq);
     MPM_SCALAR(utime);
@@ -208,11 +208,11 @@ struct Fields<Sample> {
 // sample an event concerns (DDS keys: controller, output, input).
 template <class F>
 constexpr void channel_event_fields(F& f) {
-    MPM_SCALAR(controller_id, "controller", true);
+    MPM_SCALAR(controller_id, .json = "controller", .key = true);
     MPM_SCALAR(utime);
     MPM_SCALAR(sample_sequence);
-    MPM_SCALAR(output, nullptr, true);
-    MPM_SCALAR(input, nullptr, true);
+    MPM_SCALAR(output, .key = true);
+    MPM_SCALAR(input, .key = true);
     MPM_SCALAR(output_index);
     MPM_SCALAR(input_index);
 }
@@ -225,12 +225,12 @@ struct Fields<Alarm> {
   template <class F>
   static constexpr void visit(F& f) {
     channel_event_fields(f);
-    MPM_SCALAR(raised, "state", false, false, "raised", "cleared");
-    MPM_SCALAR(f, "F");
+    MPM_SCALAR(raised, .json = "state", .json_true = "raised", .json_false = "cleared");
+    MPM_SCALAR(f, .json = "F");
     MPM_SCALAR(p_value);
     MPM_SCALAR(gamma);
     MPM_SCALAR(physics);
-    MPM_SCALAR(text, nullptr, false, true);
+    MPM_SCALAR(text, .line = true);
   }
 };
 
@@ -245,10 +245,10 @@ struct Fields<Diagnosis> {
     MPM_SCALAR(window);
     MPM_SCALAR(found);
     MPM_SCALAR(physics);
-    MPM_SCALAR(channels, nullptr, false, true);
+    MPM_SCALAR(channels, .line = true);
     MPM_NAMED_VALUES(parameter_names, parameter_values, n_parameters, parameters);
     MPM_SCALAR(holdout_improvement);
-    MPM_SCALAR(text, nullptr, false, true);
+    MPM_SCALAR(text, .line = true);
   }
 };
 
@@ -261,9 +261,9 @@ struct Fields<ChannelStatus> {
   static constexpr void visit(F& f) {
     MPM_SCALAR(output);
     MPM_SCALAR(input);
-    MPM_SCALAR(f_pairwise, "F");
-    MPM_SCALAR(f_conditional, "F_conditional");
-    MPM_SCALAR(lr, "LR");
+    MPM_SCALAR(f_pairwise, .json = "F");
+    MPM_SCALAR(f_conditional, .json = "F_conditional");
+    MPM_SCALAR(lr, .json = "LR");
     MPM_SCALAR(p_value);
     MPM_SCALAR(gamma);
     MPM_SCALAR(alarm);
@@ -293,7 +293,7 @@ struct Fields<Status> {
   static constexpr const char* json_type = "status";
   template <class F>
   static constexpr void visit(F& f) {
-    MPM_SCALAR(controller_id, "controller", true);
+    MPM_SCALAR(controller_id, .json = "controller", .key = true);
     MPM_SCALAR(utime);
     MPM_SCALAR(uptime_ms);
     MPM_SCALAR(ready);
