@@ -5,6 +5,7 @@
 
 #include "bench/cpu_clock.hpp"
 #include "core/givens.hpp"
+#include "core/rls_common.hpp"
 
 #if defined(__x86_64__)
 #include <immintrin.h>
@@ -55,7 +56,7 @@ double ud_rss_prefix_flops(std::size_t p, std::size_t k) { return 3.0 * d(p - k)
 
 }  // namespace
 
-int prior_refresh_period(std::size_t p, double lambda) { return givens::prior_period(p, lambda); }
+int prior_refresh_period(std::size_t p, double lambda) { return KeptAlivePrior(p, lambda, 1.0).period(); }
 
 double sqrt_rls_update_flops(std::size_t p, double lambda) {
   double f = absorb_flops(0, p);  // the data row, sqrt(lambda) folded in

@@ -1,5 +1,5 @@
 // Floating-point work of one monitor update, counted analytically from the
-// algorithm in core/sqrt_rls.cpp, core/ud_rls.cpp, core/nested_rls.cpp and
+// algorithm in tests/support/sqrt_rls.cpp, core/ud_rls.cpp, core/nested_rls.cpp and
 // core/granger_monitor.cpp, and the
 // core's peak rate, measured by an FMA-throughput loop.
 //

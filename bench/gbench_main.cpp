@@ -6,13 +6,13 @@
 // BM_FmaPeak's kernel in the same run.
 #include <benchmark/benchmark.h>
 
-#include "bench/alloc_hook.hpp"
+#include "tests/support/alloc_counter.hpp"
 #include "bench/batch_baseline.hpp"
 #include "bench/flops.hpp"
 #include "bench/replay.hpp"
 #include "bench/workload.hpp"
 #include "core/bierman_rls.hpp"
-#include "core/sqrt_rls.hpp"
+#include "tests/support/sqrt_rls.hpp"
 #include "core/ud_rls.hpp"
 
 namespace mpm::bench {
@@ -30,7 +30,7 @@ void BM_MonitorUpdate(benchmark::State& state) {
   std::size_t k = warm_up(*monitor, w, 0);
   std::int64_t allocations = 0;
   {
-    AllocationScope scope;
+    test::AllocationScope scope;
     for (auto _ : state) {
       benchmark::DoNotOptimize(monitor->update(w.u_at(k), w.residual_at(k)));
       ++k;

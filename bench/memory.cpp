@@ -16,7 +16,7 @@
 #include <sstream>
 #include <vector>
 
-#include "bench/child_process.hpp"
+#include "tests/support/child_process.hpp"
 #include "sim/builtin_plants.hpp"
 
 #ifdef MPM_BENCH_HAVE_TRANSPORT
@@ -28,6 +28,7 @@
 namespace mpm::bench {
 
 namespace fs = std::filesystem;
+using namespace test;  // the process plumbing of tests/support/child_process.hpp
 
 std::string own_exe_dir() {
   std::error_code ec;
@@ -192,7 +193,7 @@ class Measurement {
   Measurement(const MpmdRun& run, std::string& why) : run_(run), why_(why), child_(run.stop_timeout) {}
 
   std::optional<MpmdMemory> run() {
-    if (!dir_.make(why_) || !write_files() || !open_transport() || !notify_.bind(dir_.file("notify.sock"), why_))
+    if (!dir_.ok(why_) || !write_files() || !open_transport() || !notify_.bind(dir_.file("notify.sock"), why_))
       return std::nullopt;
     if (!child_.start({run_.mpmd, "--config", dir_.file("mpmd.yaml")},
                       environment_with_notify_socket(dir_.file("notify.sock")), dir_.file("mpmd.log"), why_))
@@ -330,7 +331,7 @@ class Measurement {
   std::string& why_;
   // Declared before the socket and the child: removed after they are closed
   // and stopped (members are destroyed in reverse order).
-  TempDir dir_;
+  TempDir dir_{"mpm-bench"};
   NotifySocket notify_;
   std::unique_ptr<transport::Transport> transport_;
   ChildProcess child_;

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "bench/alloc_hook.hpp"
+#include "tests/support/alloc_counter.hpp"
 #include "bench/cpu_clock.hpp"
 #include "bench/workload.hpp"
 #include "config/plant_loader.hpp"
@@ -65,7 +65,7 @@ ReplayResult measure_replay(std::size_t samples) {
   ReplayResult r;
   r.samples = samples;
   {
-    AllocationScope scope;
+    test::AllocationScope scope;
     const double start = thread_cpu_seconds();
     for (std::size_t k = 0; k < samples; ++k) {
       const double* u = data.data() + k * (m + n);

@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include "bench/alloc_hook.hpp"
+#include "tests/support/alloc_counter.hpp"
 #include "bench/batch_baseline.hpp"
 #include "bench/cpu_clock.hpp"
 #include "bench/diagnose_throughput.hpp"
@@ -288,7 +288,7 @@ std::vector<Figure> run_all(const BenchOptions& options) {
   plan.add("allocations_per_update", static_cast<double>(allocations) / static_cast<double>(updates), "",
            fmt("%.0f heap allocations over %.0f timed updates and replay samples (operator new",
                static_cast<double>(allocations), static_cast<double>(updates)) +
-               (counts_malloc() ? " and malloc counted)" : " counted; malloc not: sanitizer build)"));
+               (test::counts_malloc() ? " and malloc counted)" : " counted; malloc not: sanitizer build)"));
   lcm_figures(plan);
   return plan.figures;
 }

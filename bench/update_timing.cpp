@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "bench/alloc_hook.hpp"
+#include "tests/support/alloc_counter.hpp"
 #include "bench/cpu_clock.hpp"
 #include "bench/workload.hpp"
 
@@ -21,7 +21,7 @@ UpdateTiming time_updates(std::size_t inputs, std::size_t outputs, std::size_t u
   std::vector<double> per_update(repeats);
   UpdateTiming t;
   {
-    AllocationScope scope;
+    test::AllocationScope scope;
     for (std::size_t r = 0; r < repeats; ++r) {
       const double start = thread_cpu_seconds();
       for (std::size_t i = 0; i < updates_per_repeat; ++i, ++k) monitor->update(w.u_at(k), w.residual_at(k));

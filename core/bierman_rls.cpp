@@ -53,8 +53,7 @@ BiermanRls::BiermanRls(std::size_t n_regressors, std::size_t block, double forge
     throw std::invalid_argument("BiermanRls: need whole blocks of at least one regressor");
   if (!(forgetting > 0.0 && forgetting <= 1.0)) throw std::invalid_argument("BiermanRls: forgetting must be in (0, 1]");
   if (!(regularization > 0.0)) throw std::invalid_argument("BiermanRls: regularization must be > 0");
-  prior_period_ = givens::prior_period(p_, lambda_);
-  prior_weight_ = givens::prior_weight(p_, prior_period_, lambda_, delta_);
+  prior_ = KeptAlivePrior(p_, lambda_, delta_);
   column_.resize(static_cast<Eigen::Index>(p_ + 1));
   std::size_t offset = 0;
   for (std::size_t j = 0; j <= p_; ++j) {
@@ -80,8 +79,7 @@ void BiermanRls::reset() noexcept {
     block_cov_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i % nb_)) = 1.0 / delta_;
   rss_ = 0.0;
   energy_ = 0.0;
-  next_prior_row_ = 0;
-  since_prior_ = 0;
+  prior_.reset();
   next_resync_ = 0;
 }
 
@@ -109,13 +107,7 @@ void BiermanRls::add_row(const double* x, double y, double weight) noexcept {
 }
 
 void BiermanRls::refresh_prior() noexcept {
-  if (lambda_ >= 1.0 || ++since_prior_ < prior_period_) return;
-  since_prior_ = 0;
-  double* h = h_.data();
-  std::fill(h, h + p_ + 1, 0.0);
-  h[next_prior_row_] = prior_weight_;
-  absorb(1.0, 1.0, next_prior_row_);
-  next_prior_row_ = (next_prior_row_ + 1) % p_;
+  if (const auto row = prior_.due(h_.data(), p_ + 1)) absorb(1.0, 1.0, *row);
 }
 
 void BiermanRls::absorb(double weight, double lambda, std::size_t first) noexcept {

@@ -3,7 +3,7 @@
 // covariance kept as P = U D U^T (U unit upper triangular, D diagonal) and
 // updated by Bierman's square-root-free measurement update (Bierman,
 // "Factorization Methods for Discrete Sequential Estimation", 1977), for
-// the one thing the information-form factors (SqrtRls, UdRls) do
+// the one thing the information-form factors (UdRls; SqrtRls in the tests) do
 // expensively: the conditional test of every block of a large regression.
 //
 // Why: by the Wald identity the RSS of the model without block b is
@@ -26,7 +26,7 @@
 // are checked against the information-form factor in the tests.
 //
 // Poor excitation: the prior of `regularization` per regressor is kept alive
-// as in SqrtRls (a scaled unit row every K samples, round robin).
+// by a scaled unit row every K samples, round robin (rls_common.hpp).
 #pragma once
 
 #include <cstddef>
@@ -34,11 +34,13 @@
 
 #include <Eigen/Dense>
 
+#include "core/rls_common.hpp"
+
 namespace mpm {
 
 class BiermanRls {
  public:
-  using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  using Matrix = RlsMatrix;
 
   BiermanRls() = default;
   // n_regressors a multiple of block >= 1; forgetting in (0, 1];
@@ -79,7 +81,7 @@ class BiermanRls {
   // order: what a checkpoint saves and restores (daemon/mpmd/checkpoint.hpp).
   template <class V>
   void visit_state(V&& v) {
-    v(since_prior_); v(next_prior_row_); v(u_); v(d_); v(theta_); v(h_); v(gain_); v(block_cov_);
+    v(prior_); v(u_); v(d_); v(theta_); v(h_); v(gain_); v(block_cov_);
     v(next_resync_); v(staged_weight_); v(rss_); v(energy_);
   }
 
@@ -88,10 +90,7 @@ class BiermanRls {
   std::size_t nb_ = 0;
   double lambda_ = 1.0;
   double delta_ = 1e-9;
-  int prior_period_ = 1;
-  int since_prior_ = 0;
-  double prior_weight_ = 0.0;
-  std::size_t next_prior_row_ = 0;
+  KeptAlivePrior prior_;
   Eigen::VectorXd u_;          // column j of U above the diagonal at column_[j], padded(j) values
   Eigen::Matrix<std::size_t, Eigen::Dynamic, 1> column_;  // offsets into u_
   Eigen::VectorXd d_;          // D

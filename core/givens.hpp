@@ -1,8 +1,7 @@
 // OVERVIEW
 // The Givens rotations shared by the RLS factors: the square-root one
-// (sqrt_rls.cpp, R itself) with the forgetting factor folded in, the
-// square-root-free one (ud_rls.cpp, nested_rls.cpp: R = D^1/2 U), and the
-// period of the kept-alive prior row all use.
+// (R itself, with the forgetting factor folded in: the tests' SqrtRls) and
+// the square-root-free one (ud_rls.cpp, nested_rls.cpp: R = D^1/2 U).
 #pragma once
 
 #include <algorithm>
@@ -110,21 +109,6 @@ inline Rotation rotate(double* __restrict a, double* __restrict b, std::size_t f
   return {c, s};
 }
 
-// The same rotation on the inverse's rows: [a / scale; b], columns [0, end)
-// rounded up to whole lanes (zeros past `end` in both rows, kept zero).
-inline void rotate_inverse(double* __restrict a, double* __restrict b, std::size_t end, Rotation rot,
-                           double inv_scale) noexcept {
-  const double ci = rot.c * inv_scale;
-  const double si = rot.s * inv_scale;
-  const std::size_t stop = padded(end);
-  for (std::size_t j = 0; j < stop; j += kLanes) {
-    const Lanes aj = load(a + j);
-    const Lanes bj = load(b + j);
-    store(a + j, ci * aj + rot.s * bj);
-    store(b + j, rot.c * bj - si * aj);
-  }
-}
-
 // Gentleman's square-root-free Givens rotation (Gentleman 1973; the update
 // of Miller's AS 274), for factors kept as R = D^1/2 U with U unit upper
 // triangular: absorbs row b, of weight w, into row `first` of U (u) and its
@@ -168,25 +152,6 @@ inline void rotate_sqrt_free(double* __restrict u, double& d, double* __restrict
     store(b + j, bj - x * uj);
     store(u + j, cbar * uj + sbar * bj);
   }
-}
-
-// Kept-alive prior (see sqrt_rls.hpp): one unit row every K samples, round
-// robin over `directions` regressors. K is as large as kMaxPriorPeriod allows
-// (fewer rotation chains), but a direction's prior may decay by at most
-// kPriorDip between two refreshes (directions * K samples apart).
-constexpr int kMaxPriorPeriod = 64;
-constexpr double kPriorDip = 0.25;
-
-inline int prior_period(std::size_t directions, double lambda) noexcept {
-  if (lambda >= 1.0) return 1;
-  const double k = std::floor(std::log(kPriorDip) / (static_cast<double>(directions) * std::log(lambda)));
-  return static_cast<int>(std::clamp(k, 1.0, static_cast<double>(kMaxPriorPeriod)));
-}
-
-// Weight of that row: `directions` of them add (1 - lambda) * delta *
-// directions * K to each direction, the amortised (1 - lambda) delta per sample.
-inline double prior_weight(std::size_t directions, int period, double lambda, double delta) noexcept {
-  return std::sqrt(static_cast<double>(directions) * period * (1.0 - lambda) * delta);
 }
 
 }  // namespace mpm::givens

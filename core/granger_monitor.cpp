@@ -653,15 +653,4 @@ void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
   refresh_cursor_ = part.refresh_cursor_;
 }
 
-void GrangerMonitor::full_coefficients(std::size_t output, Eigen::Ref<Eigen::VectorXd> out) const noexcept {
-  regressions_[output].solve_full(out);
-}
-
-void GrangerMonitor::pairwise_ar_coefficients(std::size_t output, std::size_t input,
-                                              Eigen::Ref<Eigen::VectorXd> out) const noexcept {
-  // out: na values, the AR part of [1, AR] of the pairwise model.
-  regressions_[output].solve_pair_prefix(input, pair_coef_);
-  out.head(static_cast<Eigen::Index>(na_)) = pair_coef_.segment(1, static_cast<Eigen::Index>(na_));
-}
-
 }  // namespace mpm

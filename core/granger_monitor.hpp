@@ -205,13 +205,6 @@ class GrangerMonitor {
   // path (evaluates an incomplete gamma function), but allocation free.
   double p_value(double lr) const noexcept;
 
-  // Full-model coefficients of output j: [intercept, AR (na), u_1 (nb), ...].
-  // Allocation free; writes into `out` (size n_regressors()).
-  void full_coefficients(std::size_t output, Eigen::Ref<Eigen::VectorXd> out) const noexcept;
-  // AR coefficients of the pairwise model [1, AR, u_i] of (output, input).
-  void pairwise_ar_coefficients(std::size_t output, std::size_t input,
-                                Eigen::Ref<Eigen::VectorXd> out) const noexcept;
-
   std::size_t n_inputs() const noexcept { return n_inputs_; }
   std::size_t n_outputs() const noexcept { return n_outputs_; }
   std::size_t n_regressors() const noexcept { return 1 + na_ + n_inputs_ * nb_; }
@@ -284,7 +277,7 @@ class GrangerMonitor {
   // models [1, AR, u_i] in one shared update (nested_rls.hpp).
   std::vector<NestedRls> regressions_;
   mutable Eigen::VectorXd pair_coef_;  // scratch: [1, AR] coefficients of a pairwise model
-  SqrtRls::Matrix scratch_;        // scratch for conditional RSS
+  NestedRls::Matrix scratch_;       // scratch for conditional RSS
   // Scratch: one output's RSS ratios [joint, conditional (m), pairwise (m)]
   // and their logarithms, taken in one vectorised call.
   Eigen::ArrayXd rss_ratios_;

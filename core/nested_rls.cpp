@@ -28,14 +28,12 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
       cols_(prefix + blocks * block_size + 1),
       lambda_(forgetting),
       delta_(regularization),
-      forgets_(forgetting < 1.0),
       wald_(wald_tests) {
   if (prefix == 0 || blocks == 0 || block_size == 0)
     throw std::invalid_argument("NestedRls: need a prefix and at least one block of regressors");
   if (!(forgetting > 0.0 && forgetting <= 1.0)) throw std::invalid_argument("NestedRls: forgetting must be in (0, 1]");
   if (!(regularization > 0.0)) throw std::invalid_argument("NestedRls: regularization must be > 0");
-  prior_period_ = givens::prior_period(a_, forgetting);
-  prior_weight_ = givens::prior_weight(a_, prior_period_, forgetting, delta_);
+  prior_ = KeptAlivePrior(a_, forgetting, delta_);
   // One spare block of lanes past the padded width (always zero): whole-lane
   // reads of a block of B columns may run past the last one.
   top_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(givens::padded(cols_) + givens::kLanes));
@@ -59,8 +57,7 @@ void NestedRls::reset() noexcept {
   if (wald_) lower_wald_.reset();
   else lower_.reset();
   for (UdRls& p : pairs_) p.reset();
-  since_prior_ = 0;
-  next_prior_row_ = 0;
+  prior_.reset();
   apriori_.setZero();
   apriori_weight_ = 0.0;
 }
@@ -154,15 +151,11 @@ void NestedRls::update_staged(NestedRls* models, std::size_t count) noexcept {
 }
 
 void NestedRls::refresh_prior() noexcept {
-  if (!forgets_ || ++since_prior_ < prior_period_) return;
-  since_prior_ = 0;
-  double* w = row_.data();
-  std::fill(w, w + cols_, 0.0);
-  w[next_prior_row_] = prior_weight_;
-  row_weight_ = 1.0;
-  absorb_top(next_prior_row_, 1.0);
-  add_to_lowers();
-  next_prior_row_ = (next_prior_row_ + 1) % a_;
+  if (const auto row = prior_.due(row_.data(), cols_)) {
+    row_weight_ = 1.0;
+    absorb_top(*row, 1.0);
+    add_to_lowers();
+  }
 }
 
 double NestedRls::rss_head(std::size_t k) const noexcept {

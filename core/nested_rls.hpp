@@ -26,7 +26,7 @@
 // models, so the first input's pairwise model gets a factor of its own too.
 //
 // Priors: the A directions' prior lives in the trapezoid and is kept alive as
-// in SqrtRls (a unit row every K samples, absorbed without forgetting and
+// in every factor (rls_common.hpp: a unit row every K samples, absorbed without forgetting and
 // passed on to every lower factor); each lower factor keeps its own B
 // directions' prior alive itself.
 #pragma once
@@ -37,14 +37,14 @@
 #include <Eigen/Dense>
 
 #include "core/bierman_rls.hpp"
-#include "core/sqrt_rls.hpp"
+#include "core/rls_common.hpp"
 #include "core/ud_rls.hpp"
 
 namespace mpm {
 
 class NestedRls {
  public:
-  using Matrix = SqrtRls::Matrix;
+  using Matrix = RlsMatrix;
 
   NestedRls() = default;
   // prefix = |A| >= 1, blocks = m >= 1, block_size = |B_i| >= 1, forgetting
@@ -122,7 +122,7 @@ class NestedRls {
   // order: what a checkpoint saves and restores (daemon/mpmd/checkpoint.hpp).
   template <class V>
   void visit_state(V&& v) {
-    v(since_prior_); v(next_prior_row_); v(top_); v(top_d_); v(lower_); v(lower_wald_); v(pairs_);
+    v(prior_); v(top_); v(top_d_); v(lower_); v(lower_wald_); v(pairs_);
     v(row_); v(row_weight_); v(apriori_); v(apriori_weight_);
   }
 
@@ -133,12 +133,8 @@ class NestedRls {
   std::size_t cols_ = 0;          // a + m nb + 1
   double lambda_ = 1.0;
   double delta_ = 1e-9;
-  bool forgets_ = false;
   bool wald_ = false;             // the full lower factor in covariance form
-  int prior_period_ = 1;
-  int since_prior_ = 0;
-  double prior_weight_ = 0.0;
-  std::size_t next_prior_row_ = 0;
+  KeptAlivePrior prior_;           // over the rows of A (the lower factors keep their own)
   Matrix top_;                    // a x (padded cols + lanes): the A rows of U, [U_AA U_AB U_Ay]
   Eigen::VectorXd top_d_;         // their weights (D)
   UdRls lower_;                   // [B_1 .. B_m | y] given A (unless wald_)

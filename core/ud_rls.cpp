@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include "core/givens.hpp"
-#include "core/sqrt_rls.hpp"
 
 namespace mpm {
 
@@ -14,8 +13,7 @@ UdRls::UdRls(std::size_t n_regressors, double forgetting, double regularization)
   if (n_regressors == 0) throw std::invalid_argument("UdRls: need at least one regressor");
   if (!(forgetting > 0.0 && forgetting <= 1.0)) throw std::invalid_argument("UdRls: forgetting must be in (0, 1]");
   if (!(regularization > 0.0)) throw std::invalid_argument("UdRls: regularization must be > 0");
-  prior_period_ = givens::prior_period(p_, lambda_);
-  prior_weight_ = givens::prior_weight(p_, prior_period_, lambda_, delta_);
+  prior_ = KeptAlivePrior(p_, lambda_, delta_);
   const auto n = static_cast<Eigen::Index>(p_ + 1);
   u_.resize(n, static_cast<Eigen::Index>(givens::padded(p_ + 1)));
   d_.resize(n);
@@ -31,8 +29,7 @@ void UdRls::reset() noexcept {
   for (std::size_t i = 0; i <= p_; ++i) u_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = 1.0;
   d_.setConstant(delta_);
   d_[static_cast<Eigen::Index>(p_)] = 0.0;
-  next_prior_row_ = 0;
-  since_prior_ = 0;
+  prior_.reset();
   ++changes_;
 }
 
@@ -87,15 +84,10 @@ void UdRls::update_staged(UdRls* const* models, std::size_t count) noexcept {
 }
 
 void UdRls::refresh_prior() noexcept {
-  if (lambda_ >= 1.0 || ++since_prior_ < prior_period_) return;
-  // As SqrtRls::refresh_prior: one unit row every K samples, round robin.
-  since_prior_ = 0;
-  double* b = work_.data();
-  std::fill(b, b + p_ + 1, 0.0);
-  b[next_prior_row_] = prior_weight_;
-  work_weight_ = 1.0;
-  absorb(next_prior_row_, 1.0);
-  next_prior_row_ = (next_prior_row_ + 1) % p_;
+  if (const auto row = prior_.due(work_.data(), p_ + 1)) {
+    work_weight_ = 1.0;
+    absorb(*row, 1.0);
+  }
 }
 
 double UdRls::rss_prefix(std::size_t k) const noexcept {
@@ -126,7 +118,7 @@ double UdRls::rss_without(std::size_t first, std::size_t count, Matrix& scratch)
     const double* src = u_.row(rr).data() + first + count;
     for (std::size_t c = 0; c < cols; ++c) dst[c] = scale * src[c];
   }
-  return SqrtRls::retriangularised_rss(scratch, rows, cols, count);
+  return retriangularised_rss(scratch, rows, cols, count);
 }
 
 void UdRls::solve_prefix(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const noexcept { solve(k, out.data()); }

@@ -1,6 +1,7 @@
 // OVERVIEW
 // Square-root-free recursive least squares with exponential forgetting: the
-// same factor as SqrtRls, kept as R = D^1/2 U (U unit upper triangular, D
+// same factor as the textbook square-root form (SqrtRls, tests/support),
+// kept as R = D^1/2 U (U unit upper triangular, D
 // diagonal weights) and updated by Gentleman's square-root-free Givens
 // rotations (givens.hpp). Each absorbed row costs three operations per
 // entry instead of four and one division per row instead of a square root
@@ -14,8 +15,8 @@
 // divisions). Rows come with a weight (a row left over from another
 // factor's rotations carries the weight they left it, see NestedRls).
 //
-// The prior (regularization per regressor) is kept alive as in SqrtRls: one
-// scaled unit row every K samples, round robin.
+// The prior (regularization per regressor) is kept alive by one scaled unit
+// row every K samples, round robin (rls_common.hpp, KeptAlivePrior).
 #pragma once
 
 #include <cstddef>
@@ -23,11 +24,13 @@
 
 #include <Eigen/Dense>
 
+#include "core/rls_common.hpp"
+
 namespace mpm {
 
 class UdRls {
  public:
-  using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  using Matrix = RlsMatrix;
 
   UdRls() = default;
   // n_regressors >= 1, forgetting in (0, 1], regularization > 0.
@@ -53,7 +56,7 @@ class UdRls {
   double rss() const noexcept { return d_[static_cast<Eigen::Index>(p_)]; }
   // Weighted RSS of the model that leaves out regressors [first,
   // first+count): rows [first, p] of R re-triangularised in `scratch` (at
-  // least (p+1) x (p+1), overwritten), as SqrtRls::rss_without. Real-time safe.
+  // least (p+1) x (p+1), overwritten), as retriangularised_rss. Real-time safe.
   double rss_without(std::size_t first, std::size_t count, Matrix& scratch) const noexcept;
   // Coefficients of the model of the first k regressors into out[0..k).
   void solve_prefix(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const noexcept;
@@ -72,17 +75,14 @@ class UdRls {
   // order: what a checkpoint saves and restores (daemon/mpmd/checkpoint.hpp).
   template <class V>
   void visit_state(V&& v) {
-    v(since_prior_); v(next_prior_row_); v(u_); v(d_); v(work_); v(work_weight_); v(changes_); v(rss_stamp_); v(rss_tail_);
+    v(prior_); v(u_); v(d_); v(work_); v(work_weight_); v(changes_); v(rss_stamp_); v(rss_tail_);
   }
 
  private:
   std::size_t p_ = 0;
   double lambda_ = 1.0;
   double delta_ = 1e-9;
-  int prior_period_ = 1;
-  int since_prior_ = 0;
-  double prior_weight_ = 0.0;
-  std::size_t next_prior_row_ = 0;
+  KeptAlivePrior prior_;
   Matrix u_;                 // (p+1) x padded(p+1), unit diagonal
   Eigen::VectorXd d_;        // p+1 diagonal weights; d_p = RSS of the full model
   Eigen::VectorXd work_;     // row being absorbed, p+1 values and padding

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <type_traits>
 
 namespace mpm::transport::dds_codec {
 
@@ -42,79 +43,92 @@ void assign(std::string& out, const char* in) {
 
 }  // namespace
 
-void to_wire(const msg::Sample& in, mpm_dds_Sample& out, Scratch& scratch) {
-  out.controller_id = view(in.controller_id);
-  out.session_id = in.session_id;
-  out.seq = in.seq;
-  out.utime = in.utime;
-  out.u = view(in.u);
-  out.y = view(in.y);
-  out.sim_y = view(in.sim_y);
-  const std::size_t n = std::min(in.extra_names.size(), in.extra_values.size());
-  scratch.extra.resize(n);
-  for (std::size_t i = 0; i < n; ++i) scratch.extra[i] = {view(in.extra_names[i]), in.extra_values[i]};
-  out.extra = view_of<dds_sequence_mpm_dds_NamedValue>(scratch.extra);
-}
-
-void to_wire(const msg::Alarm& in, mpm_dds_Alarm& out) {
-  out.controller_id = view(in.controller_id);
-  out.output = view(in.output);
-  out.input = view(in.input);
-  out.utime = in.utime;
-  out.sample_sequence = in.sample_sequence;
-  out.output_index = in.output_index;
-  out.input_index = in.input_index;
-  out.raised = in.raised;
-  out.f = in.f;
-  out.p_value = in.p_value;
-  out.gamma = in.gamma;
-  out.physics = view(in.physics);
-  out.text = view(in.text);
-}
-
 namespace {
 
-// The numeric fields of a status have the same names on both sides: one copy
-// serves both directions (strings and sequences are converted by hand).
-template <typename From, typename To>
-void copy_status_numbers(const From& in, To& out) {
-  out.utime = in.utime;
-  out.uptime_ms = in.uptime_ms;
-  out.ready = in.ready;
-  out.effective_samples = in.effective_samples;
-  out.raise_threshold = in.raise_threshold;
-  out.clear_threshold = in.clear_threshold;
-  out.samples_seen = in.samples_seen;
-  out.samples_used = in.samples_used;
-  out.dropped = in.dropped;
-  out.gaps = in.gaps;
-  out.missing = in.missing;
-  out.duplicates = in.duplicates;
-  out.out_of_order = in.out_of_order;
-  out.restarts = in.restarts;
-  out.malformed = in.malformed;
-  out.nan_samples = in.nan_samples;
-  out.alarms_raised = in.alarms_raised;
+// The scratch vector that holds the views of a nested message type.
+std::vector<mpm_dds_ChannelStatus>& scratch_for(Scratch& s, const msg::ChannelStatus*) { return s.channels; }
+std::vector<mpm_dds_LoopStatus>& scratch_for(Scratch& s, const msg::LoopStatus*) { return s.loops; }
+
+// A view of every field of `in` in `out` (the idlc type: the members have
+// the same names but for the NamedValues sequences). Nested messages and
+// named values are viewed through `scratch`.
+template <class M, class Dds>
+void view_fields(const M& in, Dds& out, Scratch& scratch) {
+  msg::for_each_field<M>([&](const auto& field) {
+    using Field = std::remove_cvref_t<decltype(field)>;
+    if constexpr (msg::is<Field>(msg::FieldKind::kArray)) {
+      using Element = msg::ElementOf<M, Field>;
+      const auto& items = field.get(in);
+      if constexpr (std::is_arithmetic_v<Element>) {
+        field.get(out) = view(items);
+      } else {
+        auto& views = scratch_for(scratch, static_cast<const Element*>(nullptr));
+        views.resize(items.size());
+        for (std::size_t i = 0; i < items.size(); ++i) {
+          views[i] = {};
+          view_fields(items[i], views[i], scratch);
+        }
+        field.get(out) = view_of<std::remove_cvref_t<decltype(field.get(out))>>(views);
+      }
+    } else if constexpr (msg::is<Field>(msg::FieldKind::kNamedValues)) {
+      const auto& names = field.names(in);
+      const auto& values = field.values(in);
+      const std::size_t n = std::min(names.size(), values.size());
+      scratch.extra.resize(n);
+      for (std::size_t i = 0; i < n; ++i) scratch.extra[i] = {view(names[i]), values[i]};
+      field.dds(out) = view_of<dds_sequence_mpm_dds_NamedValue>(scratch.extra);
+    } else if constexpr (std::is_same_v<std::remove_cvref_t<decltype(field.get(in))>, std::string>) {
+      field.get(out) = view(field.get(in));
+    } else {
+      field.get(out) = field.get(in);
+    }
+  });
+}
+
+// Copies every field of `in` (the idlc type) into `out`, assigning into the
+// storage it has.
+template <class M, class Dds>
+void copy_fields(const Dds& in, M& out) {
+  msg::for_each_field<M>([&](const auto& field) {
+    using Field = std::remove_cvref_t<decltype(field)>;
+    if constexpr (msg::is<Field>(msg::FieldKind::kArray)) {
+      using Element = msg::ElementOf<M, Field>;
+      const auto& seq = field.get(in);
+      auto& items = field.get(out);
+      if constexpr (std::is_arithmetic_v<Element>) {
+        assign(items, seq);
+      } else {
+        items.resize(seq._length);
+        for (std::uint32_t i = 0; i < seq._length; ++i) copy_fields(seq._buffer[i], items[i]);
+      }
+    } else if constexpr (msg::is<Field>(msg::FieldKind::kNamedValues)) {
+      const auto& seq = field.dds(in);
+      auto& names = field.names(out);
+      auto& values = field.values(out);
+      names.resize(seq._length);
+      values.resize(seq._length);
+      for (std::uint32_t i = 0; i < seq._length; ++i) {
+        assign(names[i], seq._buffer[i].name);
+        values[i] = seq._buffer[i].value;
+      }
+    } else if constexpr (std::is_same_v<std::remove_cvref_t<decltype(field.get(out))>, std::string>) {
+      assign(field.get(out), field.get(in));
+    } else {
+      field.get(out) = field.get(in);
+    }
+  });
 }
 
 }  // namespace
 
-void to_wire(const msg::Status& in, mpm_dds_Status& out, Scratch& scratch) {
-  out.controller_id = view(in.controller_id);
-  copy_status_numbers(in, out);
-  scratch.channels.resize(in.channels.size());
-  for (std::size_t i = 0; i < in.channels.size(); ++i) {
-    const auto& c = in.channels[i];
-    scratch.channels[i] = {view(c.output), view(c.input), c.f_pairwise, c.f_conditional,
-                           c.lr,           c.p_value,     c.gamma,      c.alarm};
-  }
-  out.channels = view_of<dds_sequence_mpm_dds_ChannelStatus>(scratch.channels);
-  scratch.loops.resize(in.loops.size());
-  for (std::size_t i = 0; i < in.loops.size(); ++i) {
-    const auto& l = in.loops[i];
-    scratch.loops[i] = {view(l.output), l.residual_variance, l.sigma1, l.sigma_full, l.alarm, l.diverging};
-  }
-  out.loops = view_of<dds_sequence_mpm_dds_LoopStatus>(scratch.loops);
+void to_wire(const msg::Sample& in, mpm_dds_Sample& out, Scratch& scratch) { view_fields(in, out, scratch); }
+void to_wire(const msg::Alarm& in, mpm_dds_Alarm& out) {
+  Scratch none;  // an alarm has no sequences
+  view_fields(in, out, none);
+}
+void to_wire(const msg::Status& in, mpm_dds_Status& out, Scratch& scratch) { view_fields(in, out, scratch); }
+void to_wire(const msg::Diagnosis& in, mpm_dds_Diagnosis& out, Scratch& scratch) {
+  view_fields(in, out, scratch);
 }
 
 namespace {
@@ -153,111 +167,9 @@ WireError from_wire(const mpm_dds_Sample& in, const SampleLimits& limits, msg::S
   return error;
 }
 
-void from_wire(const mpm_dds_Sample& in, msg::Sample& out) {
-  assign(out.controller_id, in.controller_id);
-  out.session_id = in.session_id;
-  out.seq = in.seq;
-  out.utime = in.utime;
-  assign(out.u, in.u);
-  assign(out.y, in.y);
-  assign(out.sim_y, in.sim_y);
-  out.extra_names.resize(in.extra._length);
-  out.extra_values.resize(in.extra._length);
-  for (std::uint32_t i = 0; i < in.extra._length; ++i) {
-    assign(out.extra_names[i], in.extra._buffer[i].name);
-    out.extra_values[i] = in.extra._buffer[i].value;
-  }
-}
-
-void from_wire(const mpm_dds_Alarm& in, msg::Alarm& out) {
-  assign(out.controller_id, in.controller_id);
-  assign(out.output, in.output);
-  assign(out.input, in.input);
-  out.utime = in.utime;
-  out.sample_sequence = in.sample_sequence;
-  out.output_index = in.output_index;
-  out.input_index = in.input_index;
-  out.raised = in.raised;
-  out.f = in.f;
-  out.p_value = in.p_value;
-  out.gamma = in.gamma;
-  assign(out.physics, in.physics);
-  assign(out.text, in.text);
-}
-
-void from_wire(const mpm_dds_Status& in, msg::Status& out) {
-  assign(out.controller_id, in.controller_id);
-  copy_status_numbers(in, out);
-  out.channels.resize(in.channels._length);
-  for (std::uint32_t i = 0; i < in.channels._length; ++i) {
-    const auto& c = in.channels._buffer[i];
-    auto& o = out.channels[i];
-    assign(o.output, c.output);
-    assign(o.input, c.input);
-    o.f_pairwise = c.f_pairwise;
-    o.f_conditional = c.f_conditional;
-    o.lr = c.lr;
-    o.p_value = c.p_value;
-    o.gamma = c.gamma;
-    o.alarm = c.alarm;
-  }
-  out.loops.resize(in.loops._length);
-  for (std::uint32_t i = 0; i < in.loops._length; ++i) {
-    const auto& l = in.loops._buffer[i];
-    auto& o = out.loops[i];
-    assign(o.output, l.output);
-    o.residual_variance = l.residual_variance;
-    o.sigma1 = l.sigma1;
-    o.sigma_full = l.sigma_full;
-    o.alarm = l.alarm;
-    o.diverging = l.diverging;
-  }
-}
-
-}  // namespace mpm::transport::dds_codec
-
-namespace mpm::transport::dds_codec {
-
-void to_wire(const msg::Diagnosis& in, mpm_dds_Diagnosis& out, Scratch& scratch) {
-  out.controller_id = view(in.controller_id);
-  out.output = view(in.output);
-  out.input = view(in.input);
-  out.utime = in.utime;
-  out.sample_sequence = in.sample_sequence;
-  out.output_index = in.output_index;
-  out.input_index = in.input_index;
-  out.window = in.window;
-  out.found = in.found;
-  out.physics = view(in.physics);
-  out.channels = view(in.channels);
-  const std::size_t n = std::min(in.parameter_names.size(), in.parameter_values.size());
-  scratch.extra.resize(n);
-  for (std::size_t i = 0; i < n; ++i) scratch.extra[i] = {view(in.parameter_names[i]), in.parameter_values[i]};
-  out.parameters = view_of<dds_sequence_mpm_dds_NamedValue>(scratch.extra);
-  out.holdout_improvement = in.holdout_improvement;
-  out.text = view(in.text);
-}
-
-void from_wire(const mpm_dds_Diagnosis& in, msg::Diagnosis& out) {
-  assign(out.controller_id, in.controller_id);
-  assign(out.output, in.output);
-  assign(out.input, in.input);
-  out.utime = in.utime;
-  out.sample_sequence = in.sample_sequence;
-  out.output_index = in.output_index;
-  out.input_index = in.input_index;
-  out.window = in.window;
-  out.found = in.found;
-  assign(out.physics, in.physics);
-  assign(out.channels, in.channels);
-  out.parameter_names.resize(in.parameters._length);
-  out.parameter_values.resize(in.parameters._length);
-  for (std::uint32_t i = 0; i < in.parameters._length; ++i) {
-    assign(out.parameter_names[i], in.parameters._buffer[i].name);
-    out.parameter_values[i] = in.parameters._buffer[i].value;
-  }
-  out.holdout_improvement = in.holdout_improvement;
-  assign(out.text, in.text);
-}
+void from_wire(const mpm_dds_Sample& in, msg::Sample& out) { copy_fields(in, out); }
+void from_wire(const mpm_dds_Alarm& in, msg::Alarm& out) { copy_fields(in, out); }
+void from_wire(const mpm_dds_Status& in, msg::Status& out) { copy_fields(in, out); }
+void from_wire(const mpm_dds_Diagnosis& in, msg::Diagnosis& out) { copy_fields(in, out); }
 
 }  // namespace mpm::transport::dds_codec

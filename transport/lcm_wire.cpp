@@ -1,6 +1,9 @@
 #include "transport/lcm_wire.hpp"
 
 #include <cstring>
+#include <string_view>
+#include <type_traits>
+#include <utility>
 
 // Only for the types' fingerprints: the generated decoders are not used on
 // received bytes (see the header).
@@ -40,6 +43,12 @@ class Reader {
                             (std::uint32_t{p_[2]} << 8) | std::uint32_t{p_[3]};
     v = static_cast<std::int32_t>(u);
     advance(4);
+    return true;
+  }
+  bool u8(std::uint8_t& v) noexcept {
+    if (left_ < 1) return false;
+    v = p_[0];
+    advance(1);
     return true;
   }
   bool f64(double& v) noexcept {
@@ -106,12 +115,6 @@ bool read_doubles(Reader& r, std::size_t n, std::vector<double>& out) {
   return true;
 }
 
-// Smallest encoded size of an extra: a name of length 0 (int32 + NUL) and
-// its value.
-constexpr std::size_t kMinExtraBytes = 4 + 1 + 8;
-constexpr std::size_t kMinChannelBytes = 2 * (4 + 1) + 5 * 8 + 1;
-constexpr std::size_t kMinLoopBytes = (4 + 1) + 3 * 8 + 2;
-
 #define MPM_WIRE_TRY(expr)                          \
   do {                                              \
     const WireError wire_error_ = (expr);           \
@@ -124,6 +127,131 @@ WireError need(bool ok) noexcept { return ok ? WireError::kNone : WireError::kTr
 bool dimension_ok(std::int32_t n, std::uint32_t expected, std::uint32_t cap) noexcept {
   const auto count = static_cast<std::uint32_t>(n);
   return expected != 0 ? count == expected : count <= cap;
+}
+
+template <class T>
+constexpr std::size_t scalar_bytes() noexcept {
+  if constexpr (std::is_same_v<T, bool>) return 1;
+  else if constexpr (std::is_same_v<T, std::string>) return 4 + 1;  // the empty string: length and NUL
+  else return sizeof(T);
+}
+
+// The smallest encoding of a message of type M (every array empty, every
+// string ""): what an array's length is checked against before it is read.
+template <class M>
+constexpr std::size_t min_bytes() noexcept {
+  std::size_t n = 0;
+  msg::for_each_field<M>([&](const auto& field) {
+    using Field = std::remove_cvref_t<decltype(field)>;
+    if constexpr (msg::is<Field>(msg::FieldKind::kScalar))
+      n += scalar_bytes<std::remove_cvref_t<decltype(field.get(std::declval<M&>()))>>();
+    else n += 4;  // an array's length
+  });
+  return n;
+}
+
+// What a walk may accept besides the bytes' own consistency.
+struct Caps {
+  std::uint32_t max_string;  // bytes of a string (4 x that for a `line`)
+  std::uint32_t max_items;   // elements of an array of nested messages or of named values
+  const SampleLimits* plant = nullptr;  // a sample's arrays of doubles are checked against it
+  std::int32_t n_y = 0;      // the outputs read so far (sim_y has none or as many)
+};
+
+// A sample's u and y against the plant's dimensions, sim_y none or one per output.
+WireError plant_dimension(Caps& caps, std::string_view field, std::int32_t n) noexcept {
+  const SampleLimits& plant = *caps.plant;
+  if (field == "u" && !dimension_ok(n, plant.n_u, plant.max_channels)) return WireError::kWrongInputs;
+  if (field == "y") {
+    if (!dimension_ok(n, plant.n_y, plant.max_channels)) return WireError::kWrongOutputs;
+    caps.n_y = n;
+  }
+  if (field == "sim_y" && n != 0 && n != caps.n_y) return WireError::kWrongSimOutputs;
+  return WireError::kNone;
+}
+
+template <class M, class Field>
+WireError walk_field(Reader& r, Caps& caps, const Field& field, M* out);
+
+// Walks the fields of an encoded M after its fingerprint, checking every
+// length against the bytes that remain and against `caps` before anything
+// is read. With `out`, decodes into it (assigning into the storage it has);
+// without, allocates nothing.
+template <class M>
+WireError walk(Reader& r, Caps& caps, M* out) {
+  WireError error = WireError::kNone;
+  msg::for_each_field<M>([&](const auto& field) {
+    if (error == WireError::kNone) error = walk_field<M>(r, caps, field, out);
+  });
+  return error;
+}
+
+template <class M, class Field>
+WireError walk_field(Reader& r, Caps& caps, const Field& field, M* out) {
+  if constexpr (msg::is<Field>(msg::FieldKind::kScalar)) {
+    using T = std::remove_cvref_t<decltype(field.get(std::declval<M&>()))>;
+    if constexpr (std::is_same_v<T, std::string>) {
+      const char* chars = nullptr;
+      std::size_t length = 0;
+      MPM_WIRE_TRY(r.string(chars, length, field.names.line ? caps.max_string * 4 : caps.max_string));
+      if (out != nullptr) field.get(*out).assign(chars, length);
+    } else if (out == nullptr) {
+      MPM_WIRE_TRY(need(r.skip(scalar_bytes<T>())));
+    } else if constexpr (std::is_same_v<T, bool>) {
+      std::uint8_t b = 0;
+      MPM_WIRE_TRY(need(r.u8(b)));
+      field.get(*out) = b != 0;
+    } else if constexpr (std::is_same_v<T, double>) {
+      MPM_WIRE_TRY(need(r.f64(field.get(*out))));
+    } else if constexpr (std::is_same_v<T, std::int64_t>) {
+      MPM_WIRE_TRY(need(r.i64(field.get(*out))));
+    } else {
+      MPM_WIRE_TRY(need(r.i32(field.get(*out))));
+    }
+  } else if constexpr (msg::is<Field>(msg::FieldKind::kArray)) {
+    using Element = msg::ElementOf<M, Field>;
+    std::int32_t n = 0;
+    if constexpr (std::is_same_v<Element, double>) {
+      MPM_WIRE_TRY(r.count(n, 8));
+      if (caps.plant != nullptr) MPM_WIRE_TRY(plant_dimension(caps, field.names.name, n));
+      // Assigned even when empty: a reused message must not keep the
+      // previous one's values (LCM 1.3's decoder skips zero-length arrays).
+      if (out != nullptr) MPM_WIRE_TRY(need(read_doubles(r, static_cast<std::size_t>(n), field.get(*out))));
+      else MPM_WIRE_TRY(need(r.skip(static_cast<std::size_t>(n) * 8)));
+    } else {
+      MPM_WIRE_TRY(r.count(n, min_bytes<Element>()));
+      if (static_cast<std::uint32_t>(n) > caps.max_items) return WireError::kTooManyExtras;
+      if (out != nullptr) field.get(*out).resize(static_cast<std::size_t>(n));
+      for (std::int32_t i = 0; i < n; ++i) {
+        Element* item = out != nullptr ? &field.get(*out)[static_cast<std::size_t>(i)] : nullptr;
+        MPM_WIRE_TRY(walk(r, caps, item));
+      }
+    }
+  } else {  // named values: one length, the names, the values
+    std::int32_t n = 0;
+    MPM_WIRE_TRY(r.count(n, scalar_bytes<std::string>() + 8));
+    if (static_cast<std::uint32_t>(n) > caps.max_items) return WireError::kTooManyExtras;
+    const auto count = static_cast<std::size_t>(n);
+    if (out != nullptr) field.names(*out).resize(count);
+    for (std::size_t i = 0; i < count; ++i) {
+      const char* chars = nullptr;
+      std::size_t length = 0;
+      MPM_WIRE_TRY(r.string(chars, length, caps.max_string));
+      if (out != nullptr) field.names(*out)[i].assign(chars, length);
+    }
+    if (out != nullptr) MPM_WIRE_TRY(need(read_doubles(r, count, field.values(*out))));
+    else MPM_WIRE_TRY(need(r.skip(count * 8)));
+  }
+  return WireError::kNone;
+}
+
+// An encoded M, fingerprint first, nothing after the last field.
+template <class M>
+WireError walk_message(const void* data, std::size_t size, std::int64_t hash, Caps caps, M* out) {
+  Reader r(data, size);
+  MPM_WIRE_TRY(fingerprint(r, hash));
+  MPM_WIRE_TRY(walk(r, caps, out));
+  return r.left() == 0 ? WireError::kNone : WireError::kTrailingBytes;
 }
 
 }  // namespace
@@ -145,99 +273,23 @@ const char* describe(WireError error) noexcept {
 }
 
 WireError decode_lcm_sample(const void* data, std::size_t size, const SampleLimits& limits, msg::Sample& out) {
-  Reader r(data, size);
-  MPM_WIRE_TRY(fingerprint(r, mpm_lcm::sample_t::getHash()));
-  const char* chars = nullptr;
-  std::size_t length = 0;
-  MPM_WIRE_TRY(r.string(chars, length, limits.max_string));
-  out.controller_id.assign(chars, length);
-  MPM_WIRE_TRY(need(r.i64(out.session_id) && r.i64(out.seq) && r.i64(out.utime)));
-
-  std::int32_t n_u = 0;
-  MPM_WIRE_TRY(r.count(n_u, 8));
-  if (!dimension_ok(n_u, limits.n_u, limits.max_channels)) return WireError::kWrongInputs;
-  MPM_WIRE_TRY(need(read_doubles(r, static_cast<std::size_t>(n_u), out.u)));
-
-  std::int32_t n_y = 0;
-  MPM_WIRE_TRY(r.count(n_y, 8));
-  if (!dimension_ok(n_y, limits.n_y, limits.max_channels)) return WireError::kWrongOutputs;
-  MPM_WIRE_TRY(need(read_doubles(r, static_cast<std::size_t>(n_y), out.y)));
-
-  std::int32_t n_sim = 0;
-  MPM_WIRE_TRY(r.count(n_sim, 8));
-  if (n_sim != 0 && n_sim != n_y) return WireError::kWrongSimOutputs;
-  // Assigned even when empty: a reused message must not keep the previous
-  // sample's prediction (LCM 1.3's decoder skips zero-length arrays).
-  MPM_WIRE_TRY(need(read_doubles(r, static_cast<std::size_t>(n_sim), out.sim_y)));
-
-  std::int32_t n_extra = 0;
-  MPM_WIRE_TRY(r.count(n_extra, kMinExtraBytes));
-  if (static_cast<std::uint32_t>(n_extra) > limits.max_extra) return WireError::kTooManyExtras;
-  const auto extras = static_cast<std::size_t>(n_extra);
-  out.extra_names.resize(extras);
-  for (std::string& name : out.extra_names) {
-    MPM_WIRE_TRY(r.string(chars, length, limits.max_string));
-    name.assign(chars, length);
-  }
-  MPM_WIRE_TRY(need(read_doubles(r, extras, out.extra_values)));
-  return r.left() == 0 ? WireError::kNone : WireError::kTrailingBytes;
+  return walk_message(data, size, mpm_lcm::sample_t::getHash(), Caps{limits.max_string, limits.max_extra, &limits},
+                      &out);
 }
 
 WireError check_lcm_alarm(const void* data, std::size_t size, std::uint32_t max_string) noexcept {
-  Reader r(data, size);
-  MPM_WIRE_TRY(fingerprint(r, mpm_lcm::alarm_t::getHash()));
-  MPM_WIRE_TRY(r.skip_string(max_string));                       // controller_id
-  MPM_WIRE_TRY(need(r.skip(2 * 8)));                             // utime, sample_sequence
-  MPM_WIRE_TRY(r.skip_string(max_string));                       // output
-  MPM_WIRE_TRY(r.skip_string(max_string));                       // input
-  MPM_WIRE_TRY(need(r.skip(2 * 4 + 1 + 3 * 8)));                 // indices, raised, f, p, gamma
-  MPM_WIRE_TRY(r.skip_string(max_string));                       // physics
-  MPM_WIRE_TRY(r.skip_string(max_string * 4));                   // text: one line for people
-  return r.left() == 0 ? WireError::kNone : WireError::kTrailingBytes;
+  return walk_message<msg::Alarm>(data, size, mpm_lcm::alarm_t::getHash(), Caps{max_string, 0}, nullptr);
 }
 
 WireError check_lcm_status(const void* data, std::size_t size, std::uint32_t max_string,
                            std::uint32_t max_items) noexcept {
-  Reader r(data, size);
-  MPM_WIRE_TRY(fingerprint(r, mpm_lcm::status_t::getHash()));
-  MPM_WIRE_TRY(r.skip_string(max_string));            // controller_id
-  MPM_WIRE_TRY(need(r.skip(2 * 8 + 1 + 3 * 8 + 11 * 8)));  // utime .. alarms_raised
-  std::int32_t n = 0;
-  MPM_WIRE_TRY(r.count(n, kMinChannelBytes));
-  if (static_cast<std::uint32_t>(n) > max_items) return WireError::kTooManyExtras;
-  for (std::int32_t i = 0; i < n; ++i) {
-    MPM_WIRE_TRY(r.skip_string(max_string));  // output
-    MPM_WIRE_TRY(r.skip_string(max_string));  // input
-    MPM_WIRE_TRY(need(r.skip(5 * 8 + 1)));
-  }
-  MPM_WIRE_TRY(r.count(n, kMinLoopBytes));
-  if (static_cast<std::uint32_t>(n) > max_items) return WireError::kTooManyExtras;
-  for (std::int32_t i = 0; i < n; ++i) {
-    MPM_WIRE_TRY(r.skip_string(max_string));
-    MPM_WIRE_TRY(need(r.skip(3 * 8 + 2)));
-  }
-  return r.left() == 0 ? WireError::kNone : WireError::kTrailingBytes;
+  return walk_message<msg::Status>(data, size, mpm_lcm::status_t::getHash(), Caps{max_string, max_items}, nullptr);
 }
 
 WireError check_lcm_diagnosis(const void* data, std::size_t size, std::uint32_t max_string,
                               std::uint32_t max_items) noexcept {
-  Reader r(data, size);
-  MPM_WIRE_TRY(fingerprint(r, mpm_lcm::diagnosis_t::getHash()));
-  MPM_WIRE_TRY(r.skip_string(max_string));                       // controller_id
-  MPM_WIRE_TRY(need(r.skip(2 * 8)));                             // utime, sample_sequence
-  MPM_WIRE_TRY(r.skip_string(max_string));                       // output
-  MPM_WIRE_TRY(r.skip_string(max_string));                       // input
-  MPM_WIRE_TRY(need(r.skip(3 * 4 + 1)));                         // indices, window, found
-  MPM_WIRE_TRY(r.skip_string(max_string));                       // physics
-  MPM_WIRE_TRY(r.skip_string(max_string * 4));                   // channels
-  std::int32_t n = 0;
-  MPM_WIRE_TRY(r.count(n, (4 + 1) + 8));                         // a name and a value each
-  if (static_cast<std::uint32_t>(n) > max_items) return WireError::kTooManyExtras;
-  for (std::int32_t i = 0; i < n; ++i) MPM_WIRE_TRY(r.skip_string(max_string));
-  MPM_WIRE_TRY(need(r.skip(static_cast<std::size_t>(n) * 8)));  // parameter_values
-  MPM_WIRE_TRY(need(r.skip(8)));                                 // holdout_improvement
-  MPM_WIRE_TRY(r.skip_string(max_string * 4));                   // text
-  return r.left() == 0 ? WireError::kNone : WireError::kTrailingBytes;
+  return walk_message<msg::Diagnosis>(data, size, mpm_lcm::diagnosis_t::getHash(), Caps{max_string, max_items},
+                                      nullptr);
 }
 
 #undef MPM_WIRE_TRY

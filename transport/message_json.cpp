@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <type_traits>
 
 namespace mpm::msg {
 
@@ -95,127 +96,57 @@ class JsonObject {
   std::string text_;
 };
 
-template <typename T, typename Fn>
-std::string array_of(const std::vector<T>& items, Fn&& to_object) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    if (i) out += ',';
-    out += to_object(items[i]);
-  }
-  return out + "]";
+// Writes every field of `m` (the names and word choices of its field list),
+// after "type" for a top-level message.
+template <class M>
+void write_fields(JsonObject& object, const M& m) {
+  if constexpr (Fields<M>::json_type != nullptr) object.field("type", Fields<M>::json_type);
+  for_each_field<M>([&](const auto& field) {
+    using Field = std::remove_cvref_t<decltype(field)>;
+    if constexpr (is<Field>(FieldKind::kArray)) {
+      using Element = ElementOf<M, Field>;
+      if constexpr (std::is_arithmetic_v<Element>) {
+        object.field(field.names.json_key(), field.get(m));
+      } else {
+        std::string items = "[";
+        for (const Element& item : field.get(m)) {
+          if (items.size() > 1) items += ',';
+          JsonObject nested;
+          write_fields(nested, item);
+          items += nested.str();
+        }
+        object.raw(field.names.json_key(), items + "]");
+      }
+    } else if constexpr (is<Field>(FieldKind::kNamedValues)) {
+      JsonObject pairs;
+      const auto& names = field.names(m);
+      const auto& values = field.values(m);
+      for (std::size_t i = 0; i < names.size() && i < values.size(); ++i) pairs.field(names[i], values[i]);
+      object.raw(field.json, pairs.str());
+    } else if constexpr (std::is_same_v<std::remove_cvref_t<decltype(field.get(m))>, bool>) {
+      if (field.names.json_true != nullptr) {
+        object.field(field.names.json_key(), field.get(m) ? field.names.json_true : field.names.json_false);
+      } else {
+        object.field(field.names.json_key(), field.get(m));
+      }
+    } else {
+      object.field(field.names.json_key(), field.get(m));
+    }
+  });
+}
+
+template <class M>
+std::string json_of(const M& m) {
+  JsonObject object;
+  write_fields(object, m);
+  return object.str();
 }
 
 }  // namespace
 
-std::string to_json(const Alarm& a) {
-  return JsonObject()
-      .field("type", "alarm")
-      .field("controller", a.controller_id)
-      .field("utime", a.utime)
-      .field("sample_sequence", a.sample_sequence)
-      .field("output", a.output)
-      .field("input", a.input)
-      .field("output_index", a.output_index)
-      .field("input_index", a.input_index)
-      .field("state", a.raised ? "raised" : "cleared")
-      .field("F", a.f)
-      .field("p_value", a.p_value)
-      .field("gamma", a.gamma)
-      .field("physics", a.physics)
-      .field("text", a.text)
-      .str();
-}
-
-std::string to_json(const Diagnosis& d) {
-  std::string parameters = "{";
-  for (std::size_t i = 0; i < d.parameter_names.size() && i < d.parameter_values.size(); ++i) {
-    if (i) parameters += ',';
-    // One-field object, its braces dropped: a name-value pair with our escaping.
-    const std::string pair = JsonObject().field(d.parameter_names[i].c_str(), d.parameter_values[i]).str();
-    parameters += pair.substr(1, pair.size() - 2);
-  }
-  parameters += '}';
-  return JsonObject()
-      .field("type", "diagnosis")
-      .field("controller", d.controller_id)
-      .field("utime", d.utime)
-      .field("sample_sequence", d.sample_sequence)
-      .field("output", d.output)
-      .field("input", d.input)
-      .field("window", d.window)
-      .field("found", d.found)
-      .field("physics", d.physics)
-      .field("channels", d.channels)
-      .raw("parameters", parameters)
-      .field("holdout_improvement", d.holdout_improvement)
-      .field("text", d.text)
-      .str();
-}
-
-std::string to_json(const Status& s) {
-  const std::string channels = array_of(s.channels, [](const ChannelStatus& c) {
-    return JsonObject()
-        .field("output", c.output)
-        .field("input", c.input)
-        .field("F", c.f_pairwise)
-        .field("F_conditional", c.f_conditional)
-        .field("LR", c.lr)
-        .field("p_value", c.p_value)
-        .field("gamma", c.gamma)
-        .field("alarm", c.alarm)
-        .str();
-  });
-  const std::string loops = array_of(s.loops, [](const LoopStatus& l) {
-    return JsonObject()
-        .field("output", l.output)
-        .field("residual_variance", l.residual_variance)
-        .field("sigma1", l.sigma1)
-        .field("sigma_full", l.sigma_full)
-        .field("alarm", l.alarm)
-        .field("diverging", l.diverging)
-        .str();
-  });
-  return JsonObject()
-      .field("type", "status")
-      .field("controller", s.controller_id)
-      .field("utime", s.utime)
-      .field("uptime_ms", s.uptime_ms)
-      .field("ready", s.ready)
-      .field("effective_samples", s.effective_samples)
-      .field("raise_threshold", s.raise_threshold)
-      .field("clear_threshold", s.clear_threshold)
-      .field("samples_seen", s.samples_seen)
-      .field("samples_used", s.samples_used)
-      .field("dropped", s.dropped)
-      .field("gaps", s.gaps)
-      .field("missing", s.missing)
-      .field("duplicates", s.duplicates)
-      .field("out_of_order", s.out_of_order)
-      .field("restarts", s.restarts)
-      .field("malformed", s.malformed)
-      .field("nan_samples", s.nan_samples)
-      .field("alarms_raised", s.alarms_raised)
-      .raw("channels", channels)
-      .raw("loops", loops)
-      .str();
-}
-
-std::string to_json(const Sample& s) {
-  JsonObject extra;
-  for (std::size_t i = 0; i < s.extra_names.size() && i < s.extra_values.size(); ++i) {
-    extra.field(s.extra_names[i], s.extra_values[i]);
-  }
-  return JsonObject()
-      .field("type", "sample")
-      .field("controller", s.controller_id)
-      .field("session_id", s.session_id)
-      .field("seq", s.seq)
-      .field("utime", s.utime)
-      .field("u", s.u)
-      .field("y", s.y)
-      .field("sim_y", s.sim_y)
-      .raw("extra", extra.str())
-      .str();
-}
+std::string to_json(const Alarm& alarm) { return json_of(alarm); }
+std::string to_json(const Status& status) { return json_of(status); }
+std::string to_json(const Sample& sample) { return json_of(sample); }
+std::string to_json(const Diagnosis& diagnosis) { return json_of(diagnosis); }
 
 }  // namespace mpm::msg

@@ -1,4 +1,4 @@
-// The process plumbing of the benches (bench/child_process.hpp), with
+// The process plumbing of the tests and benches (tests/support/child_process.hpp), with
 // /bin/sh children: a child that never gets ready and ignores SIGTERM is
 // killed and reaped, one that honours SIGTERM is stopped by it, one that
 // exits early is reported with its code and last log line, a failed execve
@@ -24,9 +24,9 @@
 #include <thread>
 #include <vector>
 
-#include "bench/child_process.hpp"
+#include "support/child_process.hpp"
 
-namespace mpm::bench {
+namespace mpm::test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -63,9 +63,9 @@ std::vector<std::string> sh(const std::string& script) { return {"/bin/sh", "-c"
 TEST(TempDir, MadeUnderTmpdirAndRemovedWithItsContents) {
   std::string kept;
   {
-    TempDir dir;
+    TempDir dir("mpm-child-test");
     std::string why;
-    ASSERT_TRUE(dir.make(why, "mpm-child-test")) << why;
+    ASSERT_TRUE(dir.ok(why)) << why;
     kept = dir.path();
     EXPECT_EQ(fs::path(kept).parent_path(), fs::temp_directory_path());
     EXPECT_EQ(fs::path(kept).filename().string().rfind("mpm-child-test-", 0), 0u) << kept;
@@ -97,7 +97,7 @@ TEST(ChildProcess, NeverReadyAndIgnoringSigtermIsKilledAndReaped) {
   TempDir dir;
   NotifySocket sock;
   std::string why;
-  ASSERT_TRUE(dir.make(why)) << why;
+  ASSERT_TRUE(dir.ok(why)) << why;
   ASSERT_TRUE(sock.bind(dir.file("notify.sock"), why)) << why;
   pid_t pid = 0;
   {
@@ -123,7 +123,7 @@ TEST(ChildProcess, NeverReadyAndIgnoringSigtermIsKilledAndReaped) {
 TEST(ChildProcess, OneThatHonoursSigtermIsStoppedByIt) {
   TempDir dir;
   std::string why;
-  ASSERT_TRUE(dir.make(why)) << why;
+  ASSERT_TRUE(dir.ok(why)) << why;
   ChildProcess child(std::chrono::seconds(30));
   ASSERT_TRUE(child.start(sh("echo armed; exec sleep 60"), {}, dir.file("child.log"), why)) << why;
   ASSERT_TRUE(wait_for_log_line(dir.file("child.log"), "armed"));
@@ -137,7 +137,7 @@ TEST(ChildProcess, ExitingBeforeReadyIsReportedWithItsCodeAndLastLogLine) {
   TempDir dir;
   NotifySocket sock;
   std::string why;
-  ASSERT_TRUE(dir.make(why)) << why;
+  ASSERT_TRUE(dir.ok(why)) << why;
   const std::string path = dir.file("notify.sock");
   ASSERT_TRUE(sock.bind(path, why)) << why;
   ::setenv("WATCHDOG_USEC", "1000000", 1);
@@ -160,7 +160,7 @@ TEST(ChildProcess, ExitingBeforeReadyIsReportedWithItsCodeAndLastLogLine) {
 TEST(ChildProcess, AFailedExecveExitsWith127AndSaysSo) {
   TempDir dir;
   std::string why;
-  ASSERT_TRUE(dir.make(why)) << why;
+  ASSERT_TRUE(dir.ok(why)) << why;
   EXPECT_FALSE(is_executable_file(dir.file("missing-program")));
   EXPECT_FALSE(is_executable_file(dir.path())) << "a folder is not a program";
   EXPECT_TRUE(is_executable_file("/bin/sh"));
@@ -173,11 +173,35 @@ TEST(ChildProcess, AFailedExecveExitsWith127AndSaysSo) {
   EXPECT_TRUE(no_child_left());
 }
 
+// The tests' way: started at once, stdout and stderr to their own files,
+// our environment plus the given entries, the exit code (128 + signal).
+TEST(ChildProcess, ForTestsSeparateOutputsAddedEnvironmentAndExitCodes) {
+  TempDir dir;
+  std::string why;
+  ASSERT_TRUE(dir.ok(why)) << why;
+  {
+    ChildProcess child(sh("echo \"out $MPM_CHILD_TEST\"; echo err >&2; exit 4"), dir.file("out"), dir.file("err"),
+                       {{"MPM_CHILD_TEST", "set"}});
+    ASSERT_TRUE(child.started());
+    EXPECT_EQ(child.wait_exit(std::chrono::seconds(30)), 4);
+    EXPECT_EQ(child.stdout_text(), "out set\n");
+    EXPECT_EQ(child.stderr_text(), "err\n");
+  }
+  {
+    ChildProcess child(sh("sleep 30"), dir.file("out2"), dir.file("err2"));
+    ASSERT_TRUE(child.started());
+    EXPECT_FALSE(child.wait_exit(milliseconds(50))) << "still running";
+    child.signal(SIGTERM);
+    EXPECT_EQ(child.wait_exit(std::chrono::seconds(30)), 128 + SIGTERM);
+  }
+  EXPECT_TRUE(no_child_left());
+}
+
 TEST(NotifySocket, ReadyIsFoundAmongOtherNotifications) {
   TempDir dir;
   NotifySocket sock;
   std::string why;
-  ASSERT_TRUE(dir.make(why)) << why;
+  ASSERT_TRUE(dir.ok(why)) << why;
   const std::string path = dir.file("notify.sock");
   ASSERT_TRUE(sock.bind(path, why)) << why;
   ASSERT_TRUE(notify(path, "STATUS=starting"));
@@ -207,4 +231,4 @@ TEST(ProcMemory, OfThisProcess) {
 }
 
 }  // namespace
-}  // namespace mpm::bench
+}  // namespace mpm::test

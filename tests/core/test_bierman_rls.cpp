@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "core/bierman_rls.hpp"
-#include "core/sqrt_rls.hpp"
+#include "support/sqrt_rls.hpp"
 #include "support/batch_qr.hpp"
 
 namespace mpm {

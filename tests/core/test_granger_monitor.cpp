@@ -8,7 +8,7 @@
 
 #include "core/granger_monitor.hpp"
 #include "core/noise_filter.hpp"
-#include "core/sqrt_rls.hpp"
+#include "support/sqrt_rls.hpp"
 #include "core/transfer_function.hpp"
 #include "support/alloc_counter.hpp"
 

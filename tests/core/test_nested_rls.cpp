@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "core/nested_rls.hpp"
-#include "core/sqrt_rls.hpp"
+#include "support/sqrt_rls.hpp"
 
 namespace mpm {
 namespace {

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "core/sqrt_rls.hpp"
+#include "support/sqrt_rls.hpp"
 #include "core/ud_rls.hpp"
 #include "support/batch_qr.hpp"
 

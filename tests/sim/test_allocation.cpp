@@ -1,28 +1,13 @@
 // ClosedLoop::step() (plant, DMC with its QP, noise, setpoints) allocates
-// nothing once set up: global operator new is counted while it runs.
+// nothing once set up: operator new and malloc (support/alloc_counter.hpp)
+// are counted while it runs.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
+#include <memory>
+#include <vector>
 
 #include "sim/scenarios.hpp"
-
-// The replacement pair below is malloc/free on both sides; GCC cannot see
-// that through inlining and warns of a mismatch that is not there.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-
-namespace {
-std::atomic<long> g_allocations{0};
-}
-
-void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#include "support/alloc_counter.hpp"
 
 namespace mpm::sim {
 namespace {
@@ -30,9 +15,12 @@ namespace {
 long allocations_during_steps(const char* name, int steps, std::size_t* constrained) {
   const Scenario& s = *find_scenario(name);
   ClosedLoop loop(default_plant(s).model, s.loop, 1);
-  const long before = g_allocations.load();
-  for (int k = 0; k < steps; ++k) loop.step();
-  const long during = g_allocations.load() - before;
+  long during = 0;
+  {
+    test::AllocationScope scope;
+    for (int k = 0; k < steps; ++k) loop.step();
+    during = static_cast<long>(scope.count());
+  }
   *constrained = loop.controller().constrained_samples();
   return during;
 }
@@ -49,10 +37,9 @@ TEST(Allocation, StepAllocatesNothing) {
 }
 
 TEST(Allocation, TheCounterSeesAllocations) {
-  const long before = g_allocations.load();
-  auto* v = new std::vector<double>(100);
-  delete v;
-  EXPECT_GE(g_allocations.load() - before, 2);
+  test::AllocationScope scope;
+  auto v = std::make_unique<std::vector<double>>(100);
+  EXPECT_GE(scope.count(), 2);  // the vector object and its buffer
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-#include "bench/child_process.hpp"
+#include "support/child_process.hpp"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -10,37 +10,53 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
+#include <utility>
 #include <thread>
 
 extern char** environ;
 
-namespace mpm::bench {
+namespace mpm::test {
 
 namespace fs = std::filesystem;
 
 using Clock = std::chrono::steady_clock;
+
+TempDir::TempDir(const std::string& prefix) {
+  std::error_code ec;
+  const fs::path base = fs::temp_directory_path(ec);  // $TMPDIR when set
+  std::string pattern = ((ec ? fs::path("/tmp") : base) / (prefix + "-XXXXXX")).string();
+  if (::mkdtemp(pattern.data()) == nullptr) {
+    error_ = "mkdtemp(" + pattern + ") failed: " + std::strerror(errno);
+  } else {
+    path_ = pattern;
+  }
+}
 
 TempDir::~TempDir() {
   std::error_code ec;
   if (!path_.empty()) fs::remove_all(path_, ec);
 }
 
-bool TempDir::make(std::string& why, const std::string& prefix) {
-  std::error_code ec;
-  const fs::path base = fs::temp_directory_path(ec);  // $TMPDIR when set
-  std::string pattern = ((ec ? fs::path("/tmp") : base) / (prefix + "-XXXXXX")).string();
-  if (::mkdtemp(pattern.data()) == nullptr) {
-    why = "mkdtemp(" + pattern + ") failed: " + std::strerror(errno);
-    return false;
-  }
-  path_ = pattern;
-  return true;
+bool TempDir::ok(std::string& why) const {
+  if (path_.empty()) why = error_;
+  return !path_.empty();
+}
+
+void TempDir::write(const std::string& name, const std::string& text) const { write_text_file(file(name), text); }
+
+std::string read_text_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 bool write_text_file(const std::string& path, const std::string& text) {
@@ -92,8 +108,15 @@ std::string describe_exit(int wait_status) {
 // ---------------------------------------------------------------------------
 // ChildProcess
 
+ChildProcess::ChildProcess(const std::vector<std::string>& args, std::string stdout_path, std::string stderr_path,
+                           const std::map<std::string, std::string>& env)
+    : stop_timeout_(0), stdout_path_(std::move(stdout_path)), stderr_path_(std::move(stderr_path)) {
+  std::string why;
+  start(args, environment_with(env), stdout_path_, why, stderr_path_);
+}
+
 bool ChildProcess::start(const std::vector<std::string>& args, const std::vector<std::string>& env,
-                         const std::string& log, std::string& why) {
+                         const std::string& log, std::string& why, const std::string& stderr_log) {
   // Everything the child needs is made before fork: between fork and exec
   // only async-signal-safe calls (no allocation: another thread of ours may
   // have held the allocator's lock when we forked).
@@ -104,13 +127,18 @@ bool ChildProcess::start(const std::vector<std::string>& args, const std::vector
   envp.push_back(nullptr);
   // "<3>" is the error level of the sd-daemon log prefix the services use.
   const std::string exec_failed =
-      "<3>mpm bench: execve of " + fs::path(args.empty() ? std::string() : args[0]).filename().string() + " failed\n";
+      "<3>execve of " + fs::path(args.empty() ? std::string() : args[0]).filename().string() + " failed\n";
   const int out = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  const int err = stderr_log.empty() ? out : ::open(stderr_log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   const int in = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
-  if (out < 0 || in < 0) {
-    why = "cannot open " + log + " or /dev/null: " + std::strerror(errno);
+  const auto close_all = [&] {
     if (out >= 0) ::close(out);
+    if (err >= 0 && err != out) ::close(err);
     if (in >= 0) ::close(in);
+  };
+  if (out < 0 || err < 0 || in < 0) {
+    why = "cannot open " + log + (stderr_log.empty() ? "" : ", " + stderr_log) + " or /dev/null: " + std::strerror(errno);
+    close_all();
     return false;
   }
   const pid_t parent = ::getpid();
@@ -123,7 +151,7 @@ bool ChildProcess::start(const std::vector<std::string>& args, const std::vector
     if (::getppid() != parent) ::_exit(126);
     ::dup2(in, 0);
     ::dup2(out, 1);
-    ::dup2(out, 2);
+    ::dup2(err, 2);
     // No descriptor of ours (sockets above all, not all opened O_CLOEXEC by
     // the libraries that own them) in the child.
     ::close_range(3, ~0U, 0);
@@ -132,8 +160,7 @@ bool ChildProcess::start(const std::vector<std::string>& args, const std::vector
     ::_exit(127);
   }
   const int fork_errno = errno;
-  ::close(out);
-  ::close(in);
+  close_all();
   if (pid_ < 0) {
     why = std::string("fork failed: ") + std::strerror(fork_errno);
     return false;
@@ -149,6 +176,20 @@ bool ChildProcess::running() {
     return false;
   }
   return true;
+}
+
+void ChildProcess::signal(int sig) const {
+  if (pid_ > 0 && !status_) ::kill(pid_, sig);
+}
+
+std::optional<int> ChildProcess::wait_exit(std::chrono::milliseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  while (running()) {
+    if (Clock::now() >= deadline) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (!status_) return std::nullopt;
+  return WIFEXITED(*status_) ? WEXITSTATUS(*status_) : 128 + WTERMSIG(*status_);
 }
 
 void ChildProcess::stop() {
@@ -167,15 +208,21 @@ void ChildProcess::stop() {
 // ---------------------------------------------------------------------------
 // sd_notify
 
-std::vector<std::string> environment_with_notify_socket(const std::string& socket_path) {
+std::vector<std::string> environment_with(const std::map<std::string, std::string>& set,
+                                          const std::vector<std::string>& drop) {
   std::vector<std::string> env;
   for (char** e = environ; e != nullptr && *e != nullptr; ++e) {
     const std::string entry = *e;
-    if (entry.rfind("NOTIFY_SOCKET=", 0) == 0 || entry.rfind("WATCHDOG_", 0) == 0) continue;
-    env.push_back(entry);
+    const std::string name = entry.substr(0, entry.find('='));
+    const bool dropped = std::any_of(drop.begin(), drop.end(), [&](const std::string& p) { return entry.rfind(p, 0) == 0; });
+    if (!dropped && !set.count(name)) env.push_back(entry);
   }
-  env.push_back("NOTIFY_SOCKET=" + socket_path);
+  for (const auto& [name, value] : set) env.push_back(name + "=" + value);
   return env;
+}
+
+std::vector<std::string> environment_with_notify_socket(const std::string& socket_path) {
+  return environment_with({{"NOTIFY_SOCKET", socket_path}}, {"WATCHDOG_"});
 }
 
 NotifySocket::~NotifySocket() {
@@ -217,4 +264,4 @@ ReadyWait wait_for_ready(NotifySocket& notify, ChildProcess& child, std::chrono:
   return ReadyWait::kTimedOut;
 }
 
-}  // namespace mpm::bench
+}  // namespace mpm::test

@@ -1,4 +1,4 @@
-#include "bench/alloc_hook.hpp"
+#include "support/alloc_counter.hpp"
 
 #include <atomic>
 #include <cerrno>
@@ -32,7 +32,7 @@ inline void note_allocation() noexcept {
 }
 }  // namespace
 
-namespace mpm::bench {
+namespace mpm::test {
 
 AllocationScope::AllocationScope() noexcept {
   g_allocations.store(0);
@@ -49,7 +49,7 @@ bool counts_malloc() noexcept {
 #endif
 }
 
-}  // namespace mpm::bench
+}  // namespace mpm::test
 
 #ifdef MPM_BENCH_COUNT_MALLOC
 extern "C" {

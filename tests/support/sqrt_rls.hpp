@@ -17,15 +17,12 @@
 // regressors is recovered by re-triangularising the trailing part of R in
 // scratch storage (rss_without, O(p^2 count)); UdRls shares that step.
 //
-// Poor excitation: with lambda < 1 the information in unexcited directions
-// decays and the covariance would blow up. A prior of weight `regularization`
-// per regressor is kept alive by re-adding, round robin, one scaled unit row
-// every K samples (the amortised equivalent of adding (1 - lambda) * delta * I
-// every sample), so R^T R >= ~delta I / 4 at all times and the covariance
-// stays bounded. K <= 64 is chosen so that a direction waits at most p * K
-// samples, during which its prior decays by no more than a factor of 4. With
-// lambda = 1 only the initial prior is added, so the fit equals batch least
-// squares with a ridge of `regularization` (negligible at 1e-9).
+// Poor excitation: the prior of `regularization` per regressor is kept alive
+// as in the core's factors (core/rls_common.hpp, KeptAlivePrior).
+//
+// Not used by the product: the monitor keeps the same factor without square
+// roots (UdRls). It lives beside the batch QR oracle as the textbook form
+// the core's factors are checked against (and for the benchmarks' baseline).
 #pragma once
 
 #include <cstddef>
@@ -33,12 +30,13 @@
 
 #include <Eigen/Dense>
 
+#include "core/rls_common.hpp"
+
 namespace mpm {
 
 class SqrtRls {
  public:
-  // Row-major: a Givens rotation walks two rows, contiguous in memory.
-  using Matrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  using Matrix = RlsMatrix;
 
   SqrtRls() = default;
   // n_regressors >= 1, forgetting in (0, 1], regularization > 0.
@@ -61,10 +59,6 @@ class SqrtRls {
   // Weighted RSS of the model that leaves out regressors [first, first+count).
   // `scratch` must be at least (p+1) x (p+1); it is overwritten. Real-time safe.
   double rss_without(std::size_t first, std::size_t count, Matrix& scratch) const noexcept;
-  // What rss_without does once it has copied the trapezoid: rows x cols of
-  // scratch, upper triangular but for `count` subdiagonals, target column
-  // last; returns the RSS left after re-triangularising it (overwritten).
-  static double retriangularised_rss(Matrix& scratch, std::size_t rows, std::size_t cols, std::size_t count) noexcept;
   // Coefficients of the model of the first k regressors (back substitution).
   // out.size() >= k; writes out[0..k). Real-time safe.
   void solve_prefix(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const noexcept;
@@ -78,10 +72,7 @@ class SqrtRls {
   double lambda_ = 1.0;
   double sqrt_lambda_ = 1.0;
   double delta_ = 1e-9;
-  int prior_period_ = 1;        // K: samples between kept-alive prior rows
-  int since_prior_ = 0;
-  double prior_weight_ = 0.0;   // sqrt(p K (1 - lambda) delta)
-  std::size_t next_prior_row_ = 0;
+  KeptAlivePrior prior_;
   Matrix r_;                // (p+1) x padded(p+1), rows padded with zeros to whole lanes (givens.hpp)
   Eigen::VectorXd work_;    // row being absorbed, p+1 values and padding
   std::uint64_t changes_ = 0;      // bumped by every absorbed row

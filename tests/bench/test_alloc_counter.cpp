@@ -8,11 +8,14 @@
 
 #include <Eigen/Dense>
 
-#include "bench/alloc_hook.hpp"
+#include "support/alloc_counter.hpp"
 #include "bench/workload.hpp"
 
 namespace mpm::bench {
 namespace {
+
+using test::AllocationScope;
+using test::counts_malloc;
 
 TEST(AllocationScope, CountsOperatorNew) {
   AllocationScope scope;

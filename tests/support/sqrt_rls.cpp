@@ -1,4 +1,4 @@
-#include "core/sqrt_rls.hpp"
+#include "support/sqrt_rls.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,8 +13,7 @@ SqrtRls::SqrtRls(std::size_t n_regressors, double forgetting, double regularizat
   if (n_regressors == 0) throw std::invalid_argument("SqrtRls: need at least one regressor");
   if (!(forgetting > 0.0 && forgetting <= 1.0)) throw std::invalid_argument("SqrtRls: forgetting must be in (0, 1]");
   if (!(regularization > 0.0)) throw std::invalid_argument("SqrtRls: regularization must be > 0");
-  prior_period_ = givens::prior_period(p_, lambda_);
-  prior_weight_ = givens::prior_weight(p_, prior_period_, lambda_, delta_);
+  prior_ = KeptAlivePrior(p_, lambda_, delta_);
   const auto n = static_cast<Eigen::Index>(p_ + 1);
   const auto width = static_cast<Eigen::Index>(givens::padded(p_ + 1));
   r_.resize(n, width);
@@ -26,8 +25,7 @@ SqrtRls::SqrtRls(std::size_t n_regressors, double forgetting, double regularizat
 void SqrtRls::reset() noexcept {
   r_.setZero();
   for (std::size_t i = 0; i < p_; ++i) r_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = std::sqrt(delta_);
-  next_prior_row_ = 0;
-  since_prior_ = 0;
+  prior_.reset();
   ++changes_;
 }
 
@@ -53,15 +51,7 @@ void SqrtRls::add_row(const double* x, double y) noexcept {
 }
 
 void SqrtRls::refresh_prior() noexcept {
-  if (lambda_ >= 1.0 || ++since_prior_ < prior_period_) return;
-  // Keep the prior alive: one unit row every K samples, round robin,
-  // weighted so that p of them add (1 - lambda) * delta * p K per direction.
-  since_prior_ = 0;
-  double* w = work_.data();
-  std::fill(w, w + p_ + 1, 0.0);
-  w[next_prior_row_] = prior_weight_;
-  absorb(next_prior_row_, 1.0);
-  next_prior_row_ = (next_prior_row_ + 1) % p_;
+  if (const auto row = prior_.due(work_.data(), p_ + 1)) absorb(*row, 1.0);
 }
 
 double SqrtRls::rss_prefix(std::size_t k) const noexcept {
@@ -94,51 +84,7 @@ double SqrtRls::rss_without(std::size_t first, std::size_t count, Matrix& scratc
     const double* src = r_.row(static_cast<Eigen::Index>(first + r)).data() + first + count;
     for (std::size_t c = 0; c < cols; ++c) dst[c] = src[c];
   }
-  return retriangularised_rss(scratch, rows, cols, count);
-}
-
-double SqrtRls::retriangularised_rss(Matrix& scratch, std::size_t rows, std::size_t cols, std::size_t count) noexcept {
-  constexpr std::size_t kChunk = 64;
-  for (std::size_t c = 0; c + 1 < cols; ++c) {
-    const std::size_t last_row = std::min(rows - 1, c + count);
-    double sigma = 0.0;  // squares below the diagonal
-    for (std::size_t r = c + 1; r <= last_row; ++r) {
-      const double v = scratch(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c));
-      sigma += v * v;
-    }
-    if (sigma == 0.0) continue;
-    double* pivot = scratch.row(static_cast<Eigen::Index>(c)).data();
-    const double alpha = pivot[c];
-    const double norm = std::sqrt(alpha * alpha + sigma);
-    const double v0 = alpha >= 0.0 ? alpha + norm : alpha - norm;  // v = [v0, x below]
-    const double tau = 2.0 / (v0 * v0 + sigma);
-    // In chunks of columns: proj = tau v^T A[c:, chunk], then A -= v proj.
-    for (std::size_t j0 = c + 1; j0 < cols; j0 += kChunk) {
-      const std::size_t j1 = std::min(cols, j0 + kChunk);
-      double proj[kChunk];
-      for (std::size_t j = j0; j < j1; ++j) proj[j - j0] = v0 * pivot[j];
-      for (std::size_t r = c + 1; r <= last_row; ++r) {
-        const double* row = scratch.row(static_cast<Eigen::Index>(r)).data();
-        const double vr = row[c];
-        for (std::size_t j = j0; j < j1; ++j) proj[j - j0] += vr * row[j];
-      }
-      for (std::size_t j = j0; j < j1; ++j) proj[j - j0] *= tau;
-      for (std::size_t j = j0; j < j1; ++j) pivot[j] -= v0 * proj[j - j0];
-      for (std::size_t r = c + 1; r <= last_row; ++r) {
-        double* row = scratch.row(static_cast<Eigen::Index>(r)).data();
-        const double vr = row[c];
-        for (std::size_t j = j0; j < j1; ++j) row[j] -= vr * proj[j - j0];
-      }
-    }
-    for (std::size_t r = c + 1; r <= last_row; ++r) scratch(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = 0.0;
-    pivot[c] = alpha >= 0.0 ? -norm : norm;
-  }
-  double s = 0.0;
-  for (std::size_t r = cols - 1; r < rows; ++r) {
-    const double v = scratch(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(cols - 1));
-    s += v * v;
-  }
-  return s;
+  return mpm::retriangularised_rss(scratch, rows, cols, count);
 }
 
 void SqrtRls::solve_prefix(std::size_t k, Eigen::Ref<Eigen::VectorXd> out) const noexcept {
