@@ -179,9 +179,13 @@ double SequentialDetector::threshold_now(std::size_t j, std::size_t k) const noe
   const auto kk = static_cast<Eigen::Index>(k);
   const double eff = 2.0 * var_norm_[j * windows() + k];
   if (!(eff < window_[kk])) return threshold_table_(0, kk);
-  const double g = std::ceil(kTableSteps * std::log2(window_[kk] / std::max(eff, 1.0)));
+  // Linear in log memory between the table's entries.
+  const double g = kTableSteps * std::log2(window_[kk] / std::max(eff, 1.0));
   const auto last = threshold_table_.rows() - 1;
-  return threshold_table_(std::min(static_cast<Eigen::Index>(g), last), kk);
+  const auto below = std::min(static_cast<Eigen::Index>(g), last);
+  if (below == last) return threshold_table_(last, kk);
+  const double f = g - static_cast<double>(below);
+  return (1.0 - f) * threshold_table_(below, kk) + f * threshold_table_(below + 1, kk);
 }
 
 std::size_t SequentialDetector::strongest(std::size_t j) const noexcept {

@@ -41,9 +41,10 @@
 // exp(-2 rho sigma ...) correction; Basseville & Nikiforov 1993 sec. 5.2):
 //   rate_W(h) ~ c * f_d(h) * 2 (h - d) / W * exp(-beta * sqrt(period / W)),
 // f_d the chi-square density. c and beta were fitted by simulation of the
-// ideal process (d = 10, 20, 40; W = 100..6400; period 6; 4e6 samples each:
-// /tmp fits reproduced by tests/core/test_sequential_detector.cpp within its
-// confidence interval) and `mpm calibrate` refits c on a plant's own closed
+// ideal process (d = 10, 20, 40; W = 100..6400; period 6; 4e6 samples each;
+// tests/core/test_sequential_detector.cpp checks the rate, growing phase
+// included, on that process at d = 4 with c = 1.2: 0.78 x the stated rate,
+// 95 % CI 0.63..0.96, 39 of 94 raises in the first half) and `mpm calibrate` refits c on a plant's own closed
 // loop. The stated rate of the whole controller is split equally over
 // statistics x outputs x windows (Bonferroni) and each h_W solves
 // rate_W(h_W) = share.
@@ -54,8 +55,7 @@
 // law-of-the-iterated-logarithm regime: a growing-window chi-square process
 // in log time). The threshold therefore follows the effective memory:
 // h_W(k) = h for a window of memory min(2 V_W, W), from a table fixed at
-// setup (4 memories per octave, the next shorter one's level, which is
-// conservative), so the rate per sample stays the share from the first
+// setup (4 memories per octave, linear in log memory between them), so the rate per sample stays the share from the first
 // look on (flat in time) and the thresholds fall to the stationary ones as
 // the window fills. Calibrated thresholds (`mpm calibrate`) fix each
 // window's constant c_W, and the table is scaled by it. An output
