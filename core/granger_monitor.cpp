@@ -172,8 +172,31 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   // Long windows are looked at when their information is refreshed: one
   // (output, window) every kRefreshEvery samples, round robin.
   const double long_period = static_cast<double>(kRefreshEvery * n_outputs * static_cast<std::size_t>(std::max(detector.windows - 1, 1)));
+  // Two statistics share the stated rate (Bonferroni): the full score (m nb
+  // dof) and the focused one (m dof), whose threshold at the same rate is
+  // far lower, so a mismatch in the direction it tests (a gain, mostly
+  // also a time constant or dead time of a model-filtered channel) crosses
+  // it with a fraction of the samples.
+  detector.false_alarms_per_year *= 0.5;
   detector_ = SequentialDetector(n_outputs, d, detector, n_outputs, long_period,
                                  static_cast<double>(kFirstWindowEvery));
+  DetectorSettings focused = detector;
+  focused.thresholds.clear();  // `mpm calibrate` fits the full score's
+  // The focused first window is looked at with every refresh of its output.
+  focused_ = SequentialDetector(n_outputs, n_inputs, focused, n_outputs, long_period,
+                                static_cast<double>(kRefreshEvery * n_outputs));
+  focused_dir_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nb_), static_cast<Eigen::Index>(n_outputs));
+  for (std::size_t j = 0; j < n_outputs; ++j) {
+    auto v = focused_dir_.col(static_cast<Eigen::Index>(j));
+    v[0] = 1.0;
+    if (settings.input_pole == 0.0 && n_inverse_ar_[j])
+      for (std::size_t l = 1; l < nb_ && l <= na_; ++l) v[static_cast<Eigen::Index>(l)] = -(*n_inverse_ar_[j])[static_cast<Eigen::Index>(l - 1)];
+    v.normalize();
+  }
+  focused_row_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_inputs));
+  focused_info_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(n_inputs), static_cast<Eigen::Index>(n_inputs));
+  focused_llt_ = factored_identity(static_cast<Eigen::Index>(n_inputs));
+  focused_solve_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_inputs));
   output_used_.assign(n_outputs, 0);
   output_sum_w_.assign(n_outputs, 0.0);
   score_scratch_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(d));
@@ -191,7 +214,14 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   // is heavy tailed (measured: raises ~100 samples after the warm-up).
   burn_in_ = std::max<std::uint64_t>(static_cast<std::uint64_t>(warmup_),
                                      settings.forgetting < 1.0 ? static_cast<std::uint64_t>(std::min(1.0 / (1.0 - settings.forgetting), 1e6)) : 0);
-  refresh_last_.assign(n_outputs * detector_.windows(), burn_in_);
+  // The score accumulates from the factor's first sample, so the first
+  // window's weights (rho_0^2 = lambda) are those of S, its normaliser,
+  // from the start: started at the burn-in instead, its few hundred recent
+  // samples were normalised by S of the whole memory and crossed whenever
+  // the excitation had moved (measured: raises clustered right after the
+  // burn-in on all three plants).
+  score_start_ = 1;
+  refresh_last_.assign(n_outputs * detector_.windows(), score_start_);
   refresh_count_.assign(n_outputs * detector_.windows(), 0);
   last_good_.assign(n_outputs, 0.0);
   jump_scale_.assign(n_outputs, 0.0);
@@ -218,12 +248,13 @@ void GrangerMonitor::reset() noexcept {
   for (auto& c : channels_) c.gamma = NAN;
   used_since_reset_ = 0;
   detector_.reset();
+  focused_.reset();
   std::fill(output_used_.begin(), output_used_.end(), 0);
   std::fill(output_sum_w_.begin(), output_sum_w_.end(), 0.0);
   std::fill(jump_scale_.begin(), jump_scale_.end(), 0.0);
   std::fill(outlier_run_.begin(), outlier_run_.end(), 0);
   std::fill(screened_.begin(), screened_.end(), 0);
-  std::fill(refresh_last_.begin(), refresh_last_.end(), burn_in_);
+  std::fill(refresh_last_.begin(), refresh_last_.end(), score_start_);
   std::fill(refresh_count_.begin(), refresh_count_.end(), 0);
   refresh_tick_ = 0;
   refresh_cursor_ = 0;
@@ -236,13 +267,14 @@ void GrangerMonitor::reset_output(std::size_t j) noexcept {
   regressions_[j].reset();
   residual_lags_.col(jj).setZero();
   detector_.reset_output(j);
+  focused_.reset_output(j);
   output_used_[j] = 0;
   output_sum_w_[j] = 0.0;
   jump_scale_[j] = 0.0;
   outlier_run_[j] = 0;
   screened_[j] = 0;
   for (std::size_t k = 0; k < detector_.windows(); ++k) {
-    refresh_last_[j * detector_.windows() + k] = burn_in_;
+    refresh_last_[j * detector_.windows() + k] = score_start_;
     refresh_count_[j * detector_.windows() + k] = 0;
   }
   mean_fast_[jj] = 0.0;
@@ -472,7 +504,7 @@ void GrangerMonitor::refresh_long_windows() noexcept {
   const std::size_t c = refresh_cursor_;
   refresh_cursor_ = (refresh_cursor_ + 1) % pairs;
   const std::size_t j = c / (kw - 1), k = 1 + c % (kw - 1);
-  if (j < first_output_ || j >= end_output_ || output_used_[j] <= burn_in_) return;
+  if (j < first_output_ || j >= end_output_ || output_used_[j] <= score_start_) return;
   const NestedRls& reg = regressions_[j];
   const std::size_t d = n_inputs_ * nb_;
   if (reg.covariance_form()) {  // S = P^-1
@@ -488,16 +520,54 @@ void GrangerMonitor::refresh_long_windows() noexcept {
   const double gap = static_cast<double>(output_used_[j] - last);
   last = output_used_[j];
   detector_.refresh_information(j, k, info_scratch_, gap);
+  // The focused information per sample: v^T S_ab v for every pair of
+  // inputs (locate_x_ as scratch: no allocation).
+  const auto nb = static_cast<Eigen::Index>(nb_);
+  const auto dir = focused_dir_.col(static_cast<Eigen::Index>(j));
+  for (std::size_t a = 0; a < n_inputs_; ++a)
+    for (std::size_t b = 0; b < n_inputs_; ++b)
+    {
+      locate_x_.noalias() = info_scratch_.block(static_cast<Eigen::Index>(a) * nb, static_cast<Eigen::Index>(b) * nb, nb, nb) * dir;
+      focused_info_(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = dir.dot(locate_x_);
+    }
+  focused_.refresh_information(j, k, focused_info_, gap);
+  if (output_used_[j] >= burn_in_ && !loops_[j].diverging) test_focused(j, 0);
   std::uint32_t& count = refresh_count_[j * kw + k];
   if (count < kMinRefreshes) ++count;
-  // ... and once the score has run for half the first window's memory.
-  if (count < kMinRefreshes || output_used_[j] < burn_in_ + static_cast<std::uint64_t>(detector_.window(0) / 2) ||
+  // ... and once its memory 2 V is past the shorter window's: before, it
+  // holds the same samples as that window with a coarser J_W (snapshots of
+  // S every few hundred samples), and its tests only add false alarms
+  // (measured: raises clustered at the start on the quadruple tank).
+  if (count < kMinRefreshes || output_used_[j] < burn_in_ || 2.0 * detector_.weight(j, k) < detector_.window(k - 1) ||
       !detector_.has_information(j, k) || loops_[j].diverging)
     return;
   // T = s^T J^-1 s / sigma_W^2, both of the window's own memory.
   const double var = detector_.variance(j, k);
   const double t = detector_.normalised_quadratic(j, k) / var;
-  if (std::isfinite(t)) react(j, k, t, 1.0 / var);
+  if (std::isfinite(t)) react(j, k, t, false);
+  test_focused(j, k);
+}
+
+void GrangerMonitor::test_focused(std::size_t j, std::size_t k) noexcept {
+  double t = 0.0;
+  if (k == 0) {
+    // J_0 = V_0 S_sub / n: the first window's weights are the factor's.
+    focused_llt_.compute(focused_info_);
+    if (focused_llt_.info() != Eigen::Success) return;
+    focused_solve_ = Eigen::Map<const Eigen::VectorXd>(focused_.sum(j, 0), focused_solve_.size());
+    focused_llt_.matrixL().solveInPlace(focused_solve_);
+    t = focused_solve_.squaredNorm() / (focused_.variance(j, 0) * focused_.weight(j, 0));
+  } else {
+    if (!focused_.has_information(j, k)) return;
+    t = focused_.normalised_quadratic(j, k) / focused_.variance(j, k);
+  }
+  if (std::isfinite(t)) react(j, k, t, true);
+}
+
+double GrangerMonitor::full_scale(std::size_t j, std::size_t k) const noexcept {
+  if (k > 0) return 1.0 / detector_.variance(j, k);
+  const double n = output_sum_w_[j];
+  return n * n / (regressions_[j].rss_prefix_only() * detector_.weight(j, 0));
 }
 
 void GrangerMonitor::update_detector(std::size_t j) noexcept {
@@ -511,12 +581,18 @@ void GrangerMonitor::update_detector(std::size_t j) noexcept {
     reset_output(j);
     return;
   }
-  if (output_used_[j] < burn_in_) return;
+  if (output_used_[j] < score_start_) return;
   // Score of the inputs' block against the AR-only model, this sample.
   const std::size_t d = n_inputs_ * nb_;
   const double* row = reg.apriori_row();
   const double w = reg.apriori_weight();
   detector_.accumulate(j, row, w * row[d], w * row[d] * row[d]);
+  const auto nb = static_cast<Eigen::Index>(nb_);
+  const auto dir = focused_dir_.col(static_cast<Eigen::Index>(j));
+  for (std::size_t i = 0; i < n_inputs_; ++i)
+    focused_row_[static_cast<Eigen::Index>(i)] = dir.dot(Eigen::Map<const Eigen::VectorXd>(row + i * nb_, nb));
+  focused_.accumulate(j, focused_row_.data(), w * row[d], w * row[d] * row[d]);
+  if (output_used_[j] < burn_in_) return;
   if (loop.diverging) {  // no verdict on a diverging loop
     loop.alarm = false;
     return;
@@ -525,27 +601,36 @@ void GrangerMonitor::update_detector(std::size_t j) noexcept {
   // variance); the long ones when refresh_long_windows() renews them.
   if ((output_used_[j] + j) % kFirstWindowEvery != 0) return;
   const double n = output_sum_w_[j];
-  const double scale = detector_.variance_factor(0) * n * n / rss_ar;
+  // Normalised by the weight the window has accumulated (not its stationary
+  // 1 / (1 - rho^2)): chi-square from the first sample of the score.
+  const double scale = n * n / (rss_ar * detector_.weight(j, 0));
   const double t = scale * reg.information_quadratic(detector_.sum(j, 0), score_scratch_.data());
   if (!std::isfinite(t)) {
     reset_output(j);
     return;
   }
-  react(j, 0, t, scale);
+  react(j, 0, t, false);
 }
 
-void GrangerMonitor::react(std::size_t j, std::size_t k, double t, double scale) noexcept {
+void GrangerMonitor::react(std::size_t j, std::size_t k, double t, bool focused) noexcept {
   LoopStats& loop = loops_[j];
-  switch (detector_.test(j, k, t)) {
+  SequentialDetector& det = focused ? focused_ : detector_;
+  const SequentialDetector& other = focused ? detector_ : focused_;
+  switch (det.test(j, k, t)) {
     case DetectorEvent::kRaised:
+      if (other.raised(j)) break;  // the output is raised already
       ++counters_.raises;
       loop.alarm = true;
       loop.score = t;
-      loop.score_threshold = detector_.threshold(k);
-      loop.score_window = detector_.window(k);
-      locate(j, k, scale);
+      loop.score_threshold = det.threshold_now(j, k);
+      loop.score_window = det.window(k);
+      // The channel from the full score of the raising window (its
+      // covariance is known for the first window and refreshed ones).
+      locate(j, k > 0 && !detector_.has_information(j, k) ? 0 : k,
+             full_scale(j, k > 0 && !detector_.has_information(j, k) ? 0 : k));
       break;
     case DetectorEvent::kCleared:
+      if (other.raised(j)) break;  // still raised by the other statistic
       loop.alarm = false;
       for (std::size_t i = 0; i < n_inputs_; ++i) {
         channels_[j * n_inputs_ + i].alarm = false;
@@ -627,6 +712,7 @@ void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
     outlier_run_[j] = part.outlier_run_[j];
     screened_[j] = part.screened_[j];
     detector_.adopt_output(part.detector_, j);
+    focused_.adopt_output(part.focused_, j);
     for (std::size_t k = 0; k < detector_.windows(); ++k) {
       refresh_last_[j * detector_.windows() + k] = part.refresh_last_[j * detector_.windows() + k];
       refresh_count_[j * detector_.windows() + k] = part.refresh_count_[j * detector_.windows() + k];

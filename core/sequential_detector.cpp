@@ -11,6 +11,10 @@ namespace mpm {
 namespace {
 
 constexpr double kSecondsPerYear = 365.25 * 86400.0;
+// Threshold table of the growing phase: kTableSteps effective memories per
+// octave, down to kShortestEffective samples.
+constexpr double kTableSteps = 4.0;
+constexpr double kShortestEffective = 16.0;
 
 double log_chi_square_density(double h, double dof) noexcept {
   const double k = 0.5 * dof;
@@ -81,20 +85,39 @@ SequentialDetector::SequentialDetector(std::size_t outputs, std::size_t dof, con
     throw std::invalid_argument("detector thresholds: need one per window");
   window_.resize(k);
   rho_.resize(k);
-  var_factor_.resize(k);
   threshold_.resize(k);
   clear_.resize(k);
   const double share =
       settings.rate_per_sample() / static_cast<double>(std::max<std::size_t>(outputs_sharing_rate, 1) * static_cast<std::size_t>(k));
   const auto d = static_cast<double>(dof);
+  dof_value_ = d;
+  clear_fraction_ = settings.clear_fraction;
+  const double longest = settings.first_window * std::pow(settings.window_ratio, static_cast<double>(k - 1));
+  const auto steps = static_cast<Eigen::Index>(
+      1 + std::ceil(kTableSteps * std::log2(std::max(longest / kShortestEffective, 1.0))));
+  threshold_table_.resize(steps, k);
   for (Eigen::Index w = 0; w < k; ++w) {
     window_[w] = settings.first_window * std::pow(settings.window_ratio, static_cast<double>(w));
     rho_[w] = 1.0 - 1.0 / window_[w];
-    var_factor_[w] = 1.0 - rho_[w] * rho_[w];
-    threshold_[w] = thresholds.empty() ? crossing_threshold(share, d, window_[w], w == 0 ? first_period : long_period, settings.crossing_constant)
-                                       : thresholds[static_cast<std::size_t>(w)];
-    if (!(std::isfinite(threshold_[w]) && threshold_[w] > 0.0))
-      throw std::invalid_argument("detector thresholds must be finite and > 0");
+    const double period = w == 0 ? first_period : long_period;
+    // The window's crossing constant: the setting's, or the one that gives a
+    // calibrated threshold (from `mpm calibrate`) its share of the rate, so
+    // the growing phase is scaled alike.
+    double c = settings.crossing_constant;
+    if (!thresholds.empty()) {
+      const double h = thresholds[static_cast<std::size_t>(w)];
+      if (!(std::isfinite(h) && h > 0.0)) throw std::invalid_argument("detector thresholds must be finite and > 0");
+      const double unit = crossing_rate(h, d, window_[w], period, 1.0);
+      c = std::isfinite(unit) && unit > 0.0 ? std::clamp(share / unit, 1e-6, 1e6) : 1e6;
+    }
+    for (Eigen::Index g = 0; g < steps; ++g) {
+      const double eff = std::max(window_[w] * std::exp2(-static_cast<double>(g) / kTableSteps), kShortestEffective);
+      threshold_table_(g, w) = crossing_threshold(share, d, eff, period, c);
+    }
+    if (!thresholds.empty()) threshold_table_(0, w) = thresholds[static_cast<std::size_t>(w)];
+    // Never below the stationary level (the formula's floor can cross over).
+    for (Eigen::Index g = 1; g < steps; ++g) threshold_table_(g, w) = std::max(threshold_table_(g, w), threshold_table_(g - 1, w));
+    threshold_[w] = threshold_table_(0, w);
     clear_[w] = d + settings.clear_fraction * std::max(threshold_[w] - d, 0.0);
   }
   sums_.resize(static_cast<Eigen::Index>(dof), static_cast<Eigen::Index>(outputs * static_cast<std::size_t>(k)));
@@ -137,23 +160,38 @@ DetectorEvent SequentialDetector::test(std::size_t j, std::size_t k, double t) n
   const std::size_t kw = windows();
   last_[j * kw + k] = t;
   if (!raised_[j]) {
-    if (t > threshold_[static_cast<Eigen::Index>(k)]) {
+    if (t > threshold_now(j, k)) {
       raised_[j] = 1;
       return DetectorEvent::kRaised;
     }
     return DetectorEvent::kNone;
   }
   for (std::size_t w = 0; w < kw; ++w)
-    if (!(last_[j * kw + w] < clear_[static_cast<Eigen::Index>(w)])) return DetectorEvent::kNone;
+    if (!(last_[j * kw + w] < dof_value_ + clear_fraction_ * std::max(threshold_now(j, w) - dof_value_, 0.0)))
+      return DetectorEvent::kNone;
   raised_[j] = 0;
   return DetectorEvent::kCleared;
+}
+
+double SequentialDetector::threshold_now(std::size_t j, std::size_t k) const noexcept {
+  // Effective memory 2 V: the relaxation rate of T_W is 1 / V (2 / W once
+  // full, 1 / n while the window grows), the rate formula's 2 / W.
+  const auto kk = static_cast<Eigen::Index>(k);
+  const double eff = 2.0 * var_norm_[j * windows() + k];
+  if (!(eff < window_[kk])) return threshold_table_(0, kk);
+  // Linear in log memory between the table's entries.
+  const double g = kTableSteps * std::log2(window_[kk] / std::max(eff, 1.0));
+  const auto last = threshold_table_.rows() - 1;
+  const auto below = std::min(static_cast<Eigen::Index>(g), last);
+  if (below == last) return threshold_table_(last, kk);
+  const double f = g - static_cast<double>(below);
+  return (1.0 - f) * threshold_table_(below, kk) + f * threshold_table_(below + 1, kk);
 }
 
 std::size_t SequentialDetector::strongest(std::size_t j) const noexcept {
   std::size_t best = 0;
   for (std::size_t w = 1; w < windows(); ++w)
-    if (last_[j * windows() + w] / threshold_[static_cast<Eigen::Index>(w)] >
-        last_[j * windows() + best] / threshold_[static_cast<Eigen::Index>(best)])
+    if (last_[j * windows() + w] / threshold_now(j, w) > last_[j * windows() + best] / threshold_now(j, best))
       best = w;
   return best;
 }

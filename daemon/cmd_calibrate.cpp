@@ -70,12 +70,13 @@ int run(int argc, char** argv) {
     for (auto& l : levels)
       for (double tail : {1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5}) l.push_back(chi_square_quantile_upper(tail, d));
     std::vector<std::vector<std::size_t>> total(det.windows(), std::vector<std::size_t>(levels[0].size(), 0));
-    std::size_t monitored = 0, raises = 0;
+    std::size_t monitored = 0, raises = 0, first_half = 0;
     for (int r = 0; r < runs; ++r) {
       const NullRun run = null_alarm_run(plant, settings, static_cast<std::uint64_t>(seed + r),
                                          static_cast<std::size_t>(samples), levels);
       monitored += run.samples;
       raises += run.raises.size();
+      for (std::size_t k : run.raises) first_half += k < run.samples / 2 ? 1 : 0;
       for (std::size_t k = 0; k < total.size(); ++k)
         for (std::size_t l = 0; l < total[k].size(); ++l) total[k][l] += run.excursions[k][l];
       std::fprintf(stderr, "\rmpm calibrate: run %d/%d (%zu samples, %zu raises at the built-in thresholds)", r + 1,
@@ -95,6 +96,19 @@ int run(int argc, char** argv) {
                   settings.detector.false_alarms_per_year, plant.sample_time, raises,
                   static_cast<double>(raises) / static_cast<double>(monitored) / plant.sample_time * 365.25 * 86400.0);
     text += line;
+    {
+      // Against the stated count, with an exact 95 % Poisson interval, and
+      // split by half-run: flat in time means about as many in each half.
+      const double stated = settings.detector.false_alarms_per_year * plant.sample_time / (365.25 * 86400.0) *
+                            static_cast<double>(monitored);
+      const auto n = static_cast<double>(raises);
+      const double lo = raises == 0 ? 0.0 : 0.5 * chi_square_quantile_upper(0.975, 2.0 * n);
+      const double hi = 0.5 * chi_square_quantile_upper(0.025, 2.0 * n + 2.0);
+      std::snprintf(line, sizeof line,
+                    "# raises %zu against %.1f stated: %.2f x (95%% CI %.2f..%.2f); first half of the runs %zu, second %zu\n",
+                    raises, stated, n / stated, lo / stated, hi / stated, first_half, raises - first_half);
+      text += line;
+    }
     for (std::size_t k = 0; k < det.windows(); ++k) {
       std::snprintf(line, sizeof line, "# window %.0f: constant %.3g from %zu excursions (built-in %.3g), threshold %.2f (built-in %.2f)\n",
                     det.window(k), c.constants[k], c.counts[k], settings.detector.crossing_constant, c.thresholds[k],

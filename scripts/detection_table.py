@@ -18,6 +18,8 @@ def main():
     ap.add_argument("--data", default="/work/shared/data")
     args = ap.parse_args()
     print(f"{'case':38s} {'truth':18s} {'offline':14s} {'live raises (output/channel@sample)':44s} agree")
+    tally = {"flagged": 0, "raised_all": 0, "raised_any": 0, "wrong_output": 0, "nominal": 0, "nominal_raised": 0}
+    ratios = []
     for case in sorted(glob.glob(os.path.join(args.data, "*", "truth.json"))):
         d = os.path.dirname(case)
         name = os.path.basename(d)
@@ -44,9 +46,32 @@ def main():
             agree = "yes" if offline and set(offline) <= set(live_outputs) else ("missed" if offline and offline != ["error"] else "-")
         else:
             agree = "yes" if not live_outputs else "FALSE ALARM"
+        samples = sum(1 for _ in open(run)) - 1
+        true_outputs = {c.split("/")[0] for c in true_channels}
+        if t and offline and offline != ["error"]:
+            tally["flagged"] += 1
+            tally["raised_all"] += agree == "yes"
+            tally["raised_any"] += bool(set(offline) & set(live_outputs))
+            for e in raises:
+                if e["output"] in set(offline):
+                    ratios.append(e["sample"] / samples)  # the offline test used the whole record
+                    break
+        if t:
+            tally["wrong_output"] += sum(1 for o in live_outputs if o not in true_outputs and o not in offline)
+        if t is False:
+            tally["nominal"] += 1
+            tally["nominal_raised"] += bool(live_outputs)
         truth_text = ("none" if t is False else "unknown" if t is None else ",".join(true_channels) or "yes")
         print(f"{name:38s} {truth_text[:18]:18s} {','.join(offline) or 'none':14s} {' '.join(first.values()) or 'none':44s} {agree}",
               flush=True)
+    ratios.sort()
+    print(f"\nmismatch cases flagged by offline: {tally['flagged']}; raised live on every flagged output: "
+          f"{tally['raised_all']}, on at least one: {tally['raised_any']}; live raises on an output neither "
+          f"true nor flagged: {tally['wrong_output']}; no-mismatch cases raised: {tally['nominal_raised']} of "
+          f"{tally['nominal']}")
+    if ratios:
+        print(f"first live raise on a flagged output / record length (the offline test's samples): median "
+              f"{ratios[len(ratios) // 2]:.2f}, max {ratios[-1]:.2f} over {len(ratios)} cases")
 
 
 if __name__ == "__main__":

@@ -59,7 +59,9 @@ TEST_P(LoopbackTest, MismatchRaisesOnlyU1ToY2AndClearsWhenThePlantReturns) {
   const msg::Alarm raised = obs.alarms().front();
   EXPECT_TRUE(alarm_is(raised, "wb", "y2", "u1", true)) << raised.text;
   EXPECT_LT(raised.sample_sequence - onset, 600);
-  EXPECT_LT(raised.p_value, 1e-5);
+  // The focused score raises early, on less evidence in the full space: the
+  // channel's conditional score names it on its own below `false_alarm`.
+  EXPECT_LT(raised.p_value, 1e-3);
   EXPECT_TRUE(obs.wait_status("wb", [](const msg::Status& s) { return s.alarms_raised == 1; }));
 
   if (GetParam() == transport::Kind::kDds) {
