@@ -28,14 +28,15 @@ struct StreamedRecord {
 
 inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::string& path,
                                          const MonitorSettings& settings, bool plain_lags,
-                                         const PartSampleCallback& on_sample) {
+                                         const PartSampleCallback& on_sample,
+                                         const config::Limits& limits = {}) {
   // Column indices and names as bind() gives them (its time check runs on
   // the rows below, with the same message).
   config::Recording header;
   std::vector<double> row;
   config::BoundRecording bound;
   {
-    config::CsvRowReader reader(path);
+    config::CsvRowReader reader(path, limits);
     header.source = path;
     header.names = reader.names();
     header.data.resize(0, static_cast<Eigen::Index>(header.names.size()));
@@ -48,7 +49,7 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
   if (have_u0) u0 = plant.operating_point->inputs;
   std::size_t n = 0;
   {
-    config::CsvRowReader reader(path);
+    config::CsvRowReader reader(path, limits);
     double last_t = 0.0;
     while (reader.next(row)) {
       const double t = row[bound.time];
@@ -83,7 +84,7 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
                      all_sim ? 0 : settling_samples(plant, 0.01, n / 10)};
   ResidualGenerator gen(plant, u0);
   std::vector<double> u(m), y(p), r(p), d(p);
-  config::CsvRowReader reader(path);
+  config::CsvRowReader reader(path, limits);
   for (std::size_t k = 0; reader.next(row); ++k) {
     for (std::size_t i = 0; i < m; ++i) u[i] = row[bound.inputs[i]];
     for (std::size_t j = 0; j < p; ++j) y[j] = row[bound.outputs[j]];
