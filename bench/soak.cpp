@@ -215,7 +215,12 @@ struct AlarmLedger {
                        static_cast<std::size_t>(a.input_index) == kTrueInput;
     if (truth && stretch->mismatched) ++stretch->raises_true;
     else if (disturbed) ++stretch->raises_disturbed;
-    else ++stretch->raises_other;
+    else {
+      if (stretch->raises_other++ == 0) {
+        stretch->first_clean_raise = a.sample_sequence - 1 - static_cast<std::int64_t>(stretch->first_sample);
+        stretch->first_clean_channel = static_cast<int>(c);
+      }
+    }
   }
   bool any() const noexcept {
     for (bool r : raised)

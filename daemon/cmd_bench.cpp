@@ -63,6 +63,17 @@ int print_soak(const bench::SoakReport& r) {
               "data; %d still raised at the end of a matched stretch; %d outputs blind (diverging) at a stretch end; "
               "%d raises while disturbed data came\n",
               found, mismatched, raised_clean, standing, blind, raised_disturbed);
+  // Where raises on clean data came: the stretch's kind, how far into it, the channel.
+  std::string where;
+  for (const bench::SoakStretch& s : r.stretches) {
+    if (s.raises_other == 0) continue;
+    char one[96];
+    std::snprintf(one, sizeof one, "%s%s+%lld (y%d<-u%d, %d)", where.empty() ? "" : ", ", bench::soak_kind_name(s.kind),
+                  static_cast<long long>(s.first_clean_raise), s.first_clean_channel / 2 + 1,
+                  s.first_clean_channel % 2 + 1, s.raises_other);
+    where += one;
+  }
+  if (!where.empty()) std::printf("clean-data raises at     %s\n", where.c_str());
   std::printf("resident memory         %.0f kB after the first stretch, max growth %.0f kB after it\n",
               r.rss_first_kb, r.rss_max_growth_kb);
   const bool ok = r.nonfinite == 0 && r.max_deviation <= 1e-6 && found == mismatched && raised_clean == 0 &&
