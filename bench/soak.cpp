@@ -218,7 +218,8 @@ struct AlarmLedger {
     else {
       if (stretch->raises_other++ == 0) {
         stretch->first_clean_raise = a.sample_sequence - 1 - static_cast<std::int64_t>(stretch->first_sample);
-        stretch->first_clean_channel = static_cast<int>(c);
+        stretch->first_clean_output = a.output_index;
+        stretch->first_clean_input = a.input_index;
       }
     }
   }

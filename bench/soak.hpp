@@ -72,7 +72,7 @@ struct SoakStretch {
   int raises_true = 0;               // raise edges on u1 -> y2
   int raises_other = 0;              // raise edges on any other channel, outside the disturbance
   std::int64_t first_clean_raise = -1;  // samples into the stretch of the first raise_other, -1: none
-  int first_clean_channel = -1;          // its channel, output * inputs + input
+  int first_clean_output = -1, first_clean_input = -1;  // its channel (0-based)
   int raises_disturbed = 0;          // raise edges while disturbed data came (gaps, NaN, outliers,
                                      // frozen, x 1e8, x 1e-8), any channel but the mismatch's
   bool raised_at_end = false;        // any channel raised when the stretch ended

@@ -69,8 +69,8 @@ int print_soak(const bench::SoakReport& r) {
     if (s.raises_other == 0) continue;
     char one[96];
     std::snprintf(one, sizeof one, "%s%s+%lld (y%d<-u%d, %d)", where.empty() ? "" : ", ", bench::soak_kind_name(s.kind),
-                  static_cast<long long>(s.first_clean_raise), s.first_clean_channel / 2 + 1,
-                  s.first_clean_channel % 2 + 1, s.raises_other);
+                  static_cast<long long>(s.first_clean_raise), s.first_clean_output + 1, s.first_clean_input + 1,
+                  s.raises_other);
     where += one;
   }
   if (!where.empty()) std::printf("clean-data raises at     %s\n", where.c_str());
