@@ -170,6 +170,18 @@ void read_checkpoint(const YamlReader& r, const Field& root, const std::string& 
     r.fail(r.child(root, "diagnosis_window"), "expected 0 (off) or a number of samples in 200..1000000");
 }
 
+// limits: {max_inputs: 200, ...}: the caps on the plant file (limits.hpp).
+void read_limits(const YamlReader& r, const Field& root, DaemonConfig& c) {
+  const Field f = r.child(root, "limits");
+  if (!f.present() || f.node.IsNull()) return;
+  if (!f.node.IsMap()) r.fail(f, "expected a map of caps (max_inputs: 200, ...)");
+  for (const auto& kv : f.node) {
+    const Field cap = r.child(f, kv.first.Scalar());
+    if (const std::string problem = set_limit(c.limits, kv.first.Scalar(), r.number(cap)); !problem.empty())
+      r.fail(cap, problem);
+  }
+}
+
 }  // namespace
 
 DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string& source_name,
@@ -185,7 +197,7 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
   try {
     r.check_keys(root, {"controller_id", "plant", "monitor", "transport", "status_period", "queue_capacity",
                         "log_interval", "max_sequence_jump", "stale_after", "checkpoint_path",
-                        "checkpoint_interval", "diagnosis_window"});
+                        "checkpoint_interval", "diagnosis_window", "limits"});
     DaemonConfig c;
     c.source = source_name;
     c.controller_id = r.name(r.child(root, "controller_id"));
@@ -196,6 +208,7 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
     read_transport(r, root, base_dir, c);
     read_service(r, root, c);
     read_checkpoint(r, root, base_dir, c);
+    read_limits(r, root, c);
     return c;
   } catch (const YAML::Exception& e) {
     throw yaml_error(e, source_name, "unexpected structure");

@@ -25,11 +25,14 @@
 //   checkpoint_path: /var/lib/mpm/mpmd.state  # relative to this file; absent = no checkpoint
 //   checkpoint_interval: 60         # seconds between checkpoints (also written at SIGTERM)
 //   diagnosis_window: 3000          # samples diagnosed (physics) at a raise; 0 = off
+//   limits: {max_inputs: 100, max_outputs: 100, max_poly_length: 200,   # caps on the plant
+//            max_delay_samples: 1000, max_yaml_bytes: 67108864}         # file (limits.hpp)
 #pragma once
 
 #include <cstdint>
 #include <string>
 
+#include "config/limits.hpp"
 #include "core/granger_monitor.hpp"
 #include "transport/transport_settings.hpp"
 
@@ -52,6 +55,7 @@ struct DaemonConfig {
   std::string checkpoint_path; // monitor state saved here and resumed at start; "" = none
   double checkpoint_interval = 60.0;  // seconds between checkpoints (and one at SIGTERM)
   int diagnosis_window = 3000; // recent samples diagnosed when an output is raised; 0 = none
+  Limits limits;               // caps on the plant file (the config file itself: the defaults)
 };
 
 // `base_dir` resolves relative paths (plant, DDS config); "" = as given.

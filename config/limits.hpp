@@ -4,11 +4,15 @@
 // or a later setup step allocate gigabytes or run for minutes. Every cap is
 // checked while loading, and its error names the file, line:column, key and
 // the allowed range. The defaults cover every plant in the tree with a wide
-// margin; a caller with a bigger plant passes its own Limits.
+// margin; a caller with a bigger plant passes its own Limits, set from the
+// daemon config's `limits:` section or the `--max-...` flags of mpm
+// (limit_rows(): one row per cap, read by both).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
+#include <vector>
 
 namespace mpm::config {
 
@@ -21,5 +25,20 @@ struct Limits {
   std::size_t max_csv_columns = 10000;     // columns of a recording's header
   std::uint64_t max_csv_bytes = std::uint64_t{16} << 30;  // a whole recording read at once
 };
+
+// One cap: its key (the daemon config's `limits:` key; the mpm flag is
+// "--" + key with '-' for '_', e.g. --max-delay-samples) and the whole
+// numbers it may be set to.
+struct LimitRow {
+  const char* key;
+  double min;
+  double max;
+  void (*set)(Limits&, double);
+};
+const std::vector<LimitRow>& limit_rows();
+
+// Sets the cap named `key` to `value`. Returns "" when done, else what is
+// wrong (no such cap, or not a whole number in its range), naming the range.
+std::string set_limit(Limits& limits, const std::string& key, double value);
 
 }  // namespace mpm::config

@@ -228,6 +228,7 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   outlier_run_.assign(n_outputs, 0);
   screened_.assign(n_outputs, 0);
   clean_.assign(n_outputs, 0.0);
+  recovered_.assign(n_outputs, 0);
   reset();
 }
 
@@ -432,16 +433,28 @@ void GrangerMonitor::update_divergence(const double* residual) noexcept {
     const auto jj = static_cast<Eigen::Index>(j);
     // Residuals carry the outputs' operating-point offset: start the running
     // mean there, not at zero.
-    if (used_since_reset_ == 1) mean_fast_[jj] = residual[j];
+    if (output_used_[j] == 0) mean_fast_[jj] = residual[j];
     const double dev = residual[j] - mean_fast_[jj];
     mean_fast_[jj] += (1.0 - kFastMemory) * dev;
     var_fast_[jj] = kFastMemory * var_fast_[jj] + (1.0 - kFastMemory) * dev * dev;
+    // With forgetting, the quietest level is that of the statistics' own
+    // memory: it rises by 1/lambda per sample, so a level from before that
+    // memory stops counting. The soak found the flag sticky: one stretch of
+    // values x 1e8 or x 1e-8 left the live monitor "diverging", and so
+    // without verdicts, for good. With lambda = 1 (a whole record) the
+    // statistics keep the diverging samples, and the flag stays.
+    const bool forgets = settings_.forgetting < 1.0;
+    if (forgets) var_baseline_[jj] /= settings_.forgetting;
     // The short-memory estimate is settled after a few hundred samples.
-    if (used_since_reset_ > 300) var_baseline_[jj] = std::min(var_baseline_[jj], var_fast_[jj]);
-    if (var_fast_[jj] > kDivergenceRatio * var_baseline_[jj]) loops_[j].diverging = true;
-    if (var_reference_[jj] > 0.0 && used_since_reset_ > 100 &&
-        var_fast_[jj] > kDivergenceOverReference * var_reference_[jj])
-      loops_[j].diverging = true;
+    if (output_used_[j] > 300) var_baseline_[jj] = std::min(var_baseline_[jj], var_fast_[jj]);
+    const bool diverging = var_fast_[jj] > kDivergenceRatio * var_baseline_[jj] ||
+                           (var_reference_[jj] > 0.0 && output_used_[j] > 100 &&
+                            var_fast_[jj] > kDivergenceOverReference * var_reference_[jj]);
+    // Back from diverging, the statistics still hold those samples (x 1e8
+    // of the rest, measured: false raises with scores of 1e8 thousands of
+    // samples later): the output starts again (update_detector).
+    if (forgets && loops_[j].diverging && !diverging) recovered_[j] = 1;
+    loops_[j].diverging = diverging || (!forgets && loops_[j].diverging);
   }
 }
 
@@ -577,7 +590,8 @@ void GrangerMonitor::update_detector(std::size_t j) noexcept {
   ++output_used_[j];
   output_sum_w_[j] = lambda * output_sum_w_[j] + 1.0;
   const double rss_ar = reg.rss_prefix_only();
-  if (!std::isfinite(rss_ar) || !std::isfinite(reg.rss_full())) {
+  if (!std::isfinite(rss_ar) || !std::isfinite(reg.rss_full()) || recovered_[j]) {
+    recovered_[j] = 0;
     reset_output(j);
     return;
   }

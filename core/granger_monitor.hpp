@@ -59,7 +59,10 @@
 // Robustness: a sample whose residual jumps by more than `outlier_limit`
 // robust standard deviations of its recent one-step changes is skipped and
 // counted (the residual lags hold the previous value); an output whose
-// statistics go non-finite starts again from its prior, counted.
+// statistics go non-finite starts again from its prior, counted. With
+// forgetting, "diverging" holds while the residual's variance is far above
+// its quietest level within the statistics' memory, and the output starts
+// again when it ends (its statistics hold the diverging samples).
 #pragma once
 
 #include <cstddef>
@@ -151,7 +154,8 @@ struct MonitorCounters {
   std::uint64_t missing = 0;     // samples with NaN/inf skipped
   std::uint64_t gaps = 0;        // runs of missing samples
   std::uint64_t outliers = 0;    // samples skipped beyond the robust bound
-  std::uint64_t resets = 0;      // outputs restarted after non-finite statistics
+  std::uint64_t resets = 0;      // outputs restarted after non-finite statistics or,
+                                 // with forgetting, at the end of a divergence
   std::uint64_t raises = 0;      // raise events of the sequential detector
   template <class V>
   void visit_state(V&& v) {
@@ -352,6 +356,9 @@ class GrangerMonitor {
   std::vector<int> outlier_run_;
   std::vector<std::uint64_t> screened_;      // samples screened since the output's (re)start
   std::vector<double> clean_;
+  // Outputs whose divergence ended this sample (with forgetting): restarted
+  // by update_detector within the same update, so never saved.
+  std::vector<std::uint8_t> recovered_;
   // Divergence detection per output: running mean and variance of d~ with a
   // short memory, and the quietest variance seen (the baseline).
   Eigen::VectorXd mean_fast_;

@@ -15,6 +15,7 @@
 #include "core/granger_monitor.hpp"
 #include "daemon/args.hpp"
 #include "daemon/command.hpp"
+#include "daemon/limit_flags.hpp"
 #include "daemon/offline.hpp"
 #include "daemon/plant_writer.hpp"
 #include "daemon/report_html.hpp"
@@ -39,6 +40,7 @@ constexpr const char* kUsage =
     "  --html REPORT.html  also write a self-contained HTML report (plots, fit %)\n"
     "  --quiet           no progress lines on standard error\n"
     "  --verbose         also list every hypothesis tried, with its statistics\n"
+    MPM_LIMIT_FLAGS_USAGE
     "  --help            this text\n";
 
 bool g_quiet = false;
@@ -173,7 +175,8 @@ void write_products(const Args& args, const std::string& plant_path, const std::
 
 int run(int argc, char** argv) {
   try {
-    const Args args(argc, argv, {"plant", "data", "json", "write-plant", "html"}, {"help", "quiet", "verbose"});
+    const Args args(argc, argv, with_limit_flags({"plant", "data", "json", "write-plant", "html"}),
+                    {"help", "quiet", "verbose"});
     if (args.flag("help")) {
       std::fputs(kUsage, stdout);
       return 0;
@@ -182,8 +185,9 @@ int run(int argc, char** argv) {
     const std::string plant_path = args.required("plant");
     const std::string data_path = args.required("data");
     if (const auto out = args.get("json")) config::refuse_input_as_output(*out, {plant_path, data_path});
-    const PlantModel plant = config::load_plant(plant_path);
-    const config::Recording rec = config::load_recording(data_path);
+    const config::Limits limits = limits_from(args);
+    const PlantModel plant = config::load_plant(plant_path, limits);
+    const config::Recording rec = config::load_recording(data_path, limits);
     const config::BoundRecording bound = config::bind(plant, rec);
     const ResidualSeries series = compute_residuals(plant, rec, bound);
     progress("residuals computed; running the Granger monitor over the record");

@@ -11,6 +11,7 @@
 #include "core/mimo_model.hpp"
 #include "daemon/args.hpp"
 #include "daemon/command.hpp"
+#include "daemon/limit_flags.hpp"
 #include "daemon/offline.hpp"
 #include "daemon/stream_monitor.hpp"
 
@@ -46,6 +47,7 @@ constexpr const char* kUsage =
     "  --false-alarms-per-year R  stated false-alarm rate of the live detector for the\n"
     "                     whole controller (default 1; the sample time is the plant's)\n"
     "  --crossing-constant C  the detector's crossing-rate constant (from mpm calibrate)\n"
+    MPM_LIMIT_FLAGS_USAGE
     "The loop verdict is the end-of-record test (the statistics after the last sample);\n"
     "'first raised' is the live detector's first raise.\n";
 
@@ -144,8 +146,9 @@ void print_event(const PlantModel& plant, const GrangerMonitor& m, std::size_t k
 
 int run(int argc, char** argv) {
   try {
-    const Args args(argc, argv, {"plant", "data", "ar-order", "input-order", "input-pole", "forgetting", "false-alarm", "threads",
-                     "false-alarms-per-year", "crossing-constant", "settle-samples"},
+    const Args args(argc, argv, with_limit_flags({"plant", "data", "ar-order", "input-order", "input-pole", "forgetting",
+                                                  "false-alarm", "threads", "false-alarms-per-year", "crossing-constant",
+                                                  "settle-samples"}),
                     {"json", "events", "plain-lags", "help"});
     if (args.flag("help")) {
       std::fputs(kUsage, stdout);
@@ -159,7 +162,8 @@ int run(int argc, char** argv) {
     settings.detector.false_alarms_per_year =
         args.number("false-alarms-per-year", settings.detector.false_alarms_per_year);
     settings.detector.crossing_constant = args.number("crossing-constant", settings.detector.crossing_constant);
-    const PlantModel plant = config::load_plant(args.required("plant"));
+    const config::Limits limits = limits_from(args);
+    const PlantModel plant = config::load_plant(args.required("plant"), limits);
     const std::string pole = args.get("input-pole").value_or("0");
     settings.input_pole = pole == "auto" ? dominant_pole(plant) : args.number("input-pole", settings.input_pole);
     if (const std::string e = settings.validate(); !e.empty()) throw UsageError(e);
@@ -187,12 +191,12 @@ int run(int argc, char** argv) {
     const GrangerMonitor monitor = [&] {
       if (requested_threads <= 1) {
         StreamedRecord r =
-            monitor_csv_stream(plant, args.required("data"), settings, args.flag("plain-lags"), on_sample, settle);
+            monitor_csv_stream(plant, args.required("data"), settings, args.flag("plain-lags"), on_sample, settle, limits);
         samples = r.samples;
         transient = r.transient;
         return std::move(r.monitor);
       }
-      const config::Recording rec = config::load_recording(args.required("data"));
+      const config::Recording rec = config::load_recording(args.required("data"), limits);
       const ResidualSeries series = compute_residuals(plant, rec, config::bind(plant, rec), settle);
       samples = rec.samples();
       transient = series.transient;

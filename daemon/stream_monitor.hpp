@@ -28,14 +28,15 @@ struct StreamedRecord {
 
 inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::string& path,
                                          const MonitorSettings& settings, bool plain_lags,
-                                         const PartSampleCallback& on_sample, int settle_samples = -1) {
+                                         const PartSampleCallback& on_sample, int settle_samples = -1,
+                                         const config::Limits& limits = {}) {
   // Column indices and names as bind() gives them (its time check runs on
   // the rows below, with the same message).
   config::Recording header;
   std::vector<double> row;
   config::BoundRecording bound;
   {
-    config::CsvRowReader reader(path);
+    config::CsvRowReader reader(path, limits);
     header.source = path;
     header.names = reader.names();
     header.data.resize(0, static_cast<Eigen::Index>(header.names.size()));
@@ -47,7 +48,7 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
   std::vector<double> u(m), y(p), sim_y(p), d(p);
   std::size_t n = 0;
   {
-    config::CsvRowReader reader(path);
+    config::CsvRowReader reader(path, limits);
     double last_t = 0.0;
     while (reader.next(row)) {
       const double t = row[bound.time];
@@ -81,7 +82,7 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
   const std::size_t settle = settle_length(plant, settle_samples, record_settle_cap(n), all_sim);
   StreamedRecord out{MonitorBlueprint(plant, settings, plain_lags).build(), n, settle};
   ResidualFrontEnd front(plant, origin.u0(), settle, std::move(use_sim));
-  config::CsvRowReader reader(path);
+  config::CsvRowReader reader(path, limits);
   for (std::size_t k = 0; reader.next(row); ++k) {
     for (std::size_t i = 0; i < m; ++i) u[i] = row[bound.inputs[i]];
     for (std::size_t j = 0; j < p; ++j) {

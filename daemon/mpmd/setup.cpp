@@ -40,7 +40,7 @@ std::optional<LoadedConfig> load_config(const std::string& path, std::string& er
   try {
     LoadedConfig loaded;
     loaded.config = config::load_daemon_config(path);
-    loaded.plant = config::load_plant(loaded.config.plant_path);
+    loaded.plant = config::load_plant(loaded.config.plant_path, loaded.config.limits);
     loaded.monitor_fingerprint = fingerprint(loaded.config);
     return loaded;
   } catch (const config::ConfigError& e) {

@@ -102,3 +102,31 @@ TEST(MonitorCli, RejectsZeroThreads) {
 }
 
 }  // namespace
+
+namespace {
+
+// The loaders' caps from --max-... flags (daemon/limit_flags.hpp): a plant
+// with a delay beyond the default cap is a located error, loads with the cap
+// raised; a bad cap is a usage error naming the flag and its range.
+TEST(MonitorCli, LimitFlagsSetTheLoadersCaps) {
+  const std::string csv = tmp_path("wb.csv");
+  ASSERT_EQ(run(kMpm + " simulate --scenario wood-berry-nominal --samples 2000 --seed 1 --out " + csv), 0);
+  std::string plant = read_file(std::string(MPM_SOURCE_DIR) + "/config/wood-berry.yaml");
+  const auto at = plant.find("delay: 8");
+  ASSERT_NE(at, std::string::npos);
+  plant.replace(at, 8, "delay: 1500");
+  const std::string slow = tmp_path("slow.yaml");
+  std::ofstream(slow) << plant;
+  const std::string err = tmp_path("err.txt");
+  const std::string cmd = kMpm + " monitor --plant " + slow + " --data " + csv;
+  EXPECT_EQ(WEXITSTATUS(std::system((cmd + " > /dev/null 2> " + err).c_str())), 1);
+  EXPECT_NE(read_file(err).find("model[2].delay: expected a delay in 0..1000 samples, got 1500"), std::string::npos)
+      << read_file(err);
+  EXPECT_EQ(run(cmd + " --max-delay-samples 2000"), 0);
+  EXPECT_EQ(WEXITSTATUS(std::system((cmd + " --max-delay-samples 1e9 > /dev/null 2> " + err).c_str())), 2);
+  EXPECT_NE(read_file(err).find("--max-delay-samples: expected a whole number in 0..10000000"), std::string::npos)
+      << read_file(err);
+  EXPECT_EQ(WEXITSTATUS(run(cmd + " --max-csv-columns 3")), 1) << "7 columns over a cap of 3";
+}
+
+}  // namespace

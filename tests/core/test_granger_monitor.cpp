@@ -185,6 +185,37 @@ TEST(GrangerMonitor, DivergingLoopIsFlaggedNotAnalysed) {
   EXPECT_FALSE(m.loop(0).diverging);
 }
 
+// With forgetting, "diverging" follows the residual: a stretch of values
+// x 1e-8 (a quiet or dead sensor) or x 1e8 once left the flag set for good
+// (no verdict ever again), found by the soak (tests/daemon/test_soak.cpp).
+// After either, the flag clears (after a quiet stretch once the baseline,
+// rising by 1/lambda per sample, is within 1e3 of the level again:
+// ln(1e13) / (1 - lambda) = 15 000 samples here), and a later mismatch is
+// raised.
+TEST(GrangerMonitor, AQuietOrLoudStretchDoesNotBlindTheLiveMonitor) {
+  for (const double scale : {1e-8, 1e8}) {
+    PlantedRun run(8);
+    GrangerMonitor m(2, 2, test_settings(), wood_berry_noise(5));
+    for (int k = 0; k < 22000; ++k) {
+      run.step();
+      const double f = k >= 2000 && k < 4000 ? scale : 1.0;
+      double u[2] = {f * run.u[0], f * run.u[1]};
+      double d[2] = {f * run.d[0], f * run.d[1]};
+      m.update(u, d);
+    }
+    EXPECT_FALSE(m.loop(0).diverging) << scale;
+    EXPECT_FALSE(m.loop(1).diverging) << scale;
+    run.dg[1][0] = DiscreteFilter(DiscreteTf{{0.5}, {1, -0.8}, 2});
+    bool raised = false;
+    for (int k = 0; k < 3000 && !raised; ++k) {
+      run.step();
+      m.update(run.u, run.d);
+      raised = m.channel(1, 0).alarm;
+    }
+    EXPECT_TRUE(raised) << scale << ": the mismatch after the stretch was not raised";
+  }
+}
+
 TEST(GrangerMonitor, OneOutlierIsSkippedCountedAndForgotten) {
   // A single 1e6 spike in a residual (a sensor glitch) used to keep the loop
   // "diverging" for thousands of samples: it is now skipped and counted.

@@ -123,6 +123,46 @@ TEST(DaemonConfig, ErrorsNameFileLineKeyAndExpectation) {
   EXPECT_NE(e.find("invalid YAML"), std::string::npos) << e;
 }
 
+// The loaders' caps (config/limits.hpp) from a `limits:` section: a plant
+// beyond a default cap loads once the cap is raised; a lowered cap refuses
+// it, located in the plant file; a bad cap is located in the config file.
+TEST(DaemonConfig, LimitsSectionSetsTheLoadersCaps) {
+  const std::string head = "controller_id: wb\nplant: wood-berry.yaml\n";
+  const auto c = parse_daemon_config(head + "limits:\n  max_inputs: 300\n  max_delay_samples: 5000\n"
+                                            "  max_csv_columns: 20\n  max_yaml_bytes: 1e6\n",
+                                     "mpmd.yaml", MPM_SOURCE_DIR "/config");
+  EXPECT_EQ(c.limits.max_inputs, 300u);
+  EXPECT_EQ(c.limits.max_delay_samples, 5000);
+  EXPECT_EQ(c.limits.max_csv_columns, 20u);
+  EXPECT_EQ(c.limits.max_yaml_bytes, 1000000u);
+  EXPECT_EQ(c.limits.max_outputs, config::Limits{}.max_outputs) << "caps not given keep their defaults";
+
+  // G21's delay is 8 samples: a cap of 4 refuses the plant, naming the file and key.
+  const auto low = parse_daemon_config(head + "limits: {max_delay_samples: 4}\n", "mpmd.yaml", MPM_SOURCE_DIR "/config");
+  try {
+    config::load_plant(low.plant_path, low.limits);
+    ADD_FAILURE() << "a delay of 8 passed a cap of 4";
+  } catch (const ConfigError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("wood-berry.yaml:"), std::string::npos) << what;
+    EXPECT_NE(what.find("delay"), std::string::npos) << what;
+    EXPECT_NE(what.find("0..4"), std::string::npos) << what;
+  }
+
+  std::string e = error_of(head + "limits:\n  max_inputs: 0\n");
+  EXPECT_NE(e.find("mpmd.yaml:4:"), std::string::npos) << e;
+  EXPECT_NE(e.find("limits.max_inputs"), std::string::npos) << e;
+  EXPECT_NE(e.find("1..10000"), std::string::npos) << e;
+  e = error_of(head + "limits:\n  max_delay_samples: 2.5\n");
+  EXPECT_NE(e.find("limits.max_delay_samples"), std::string::npos) << e;
+  EXPECT_NE(e.find("whole number"), std::string::npos) << e;
+  e = error_of(head + "limits:\n  max_pizza: 3\n");
+  EXPECT_NE(e.find("mpmd.yaml:4:"), std::string::npos) << e;
+  EXPECT_NE(e.find("no cap named max_pizza"), std::string::npos) << e;
+  e = error_of(head + "limits: [1, 2]\n");
+  EXPECT_NE(e.find("limits"), std::string::npos) << e;
+}
+
 TEST(Mpmd, InvalidConfigAtStartIsOneClearErrorAndExitOne) {
   test::TempDir dir;
   dir.write("mpmd.yaml", "controller_id: wb\nplant: " + kPlant + "\nmonitor: {false_alarm: 2}\n");

@@ -38,6 +38,11 @@ for unit in "$units/mpmd.service" "$units/mpmd@.service" "$tmp/mpmd@column-a.ser
   systemd-analyze security --offline=yes --threshold=25 "$unit" >"$tmp/security.txt" 2>&1 ||
     { tail -3 "$tmp/security.txt"; fail "$unit: hardening exposure above 2.5"; }
   echo "ok: $(basename "$unit"): $(grep 'Overall exposure' "$tmp/security.txt")"
+  # Resource and network bounds (issue 12: without them only the OOM killer
+  # stopped a 16 GB allocation).
+  for key in MemoryMax TasksMax IPAddressDeny IPAddressAllow; do
+    grep -q "^$key=" "$unit" || fail "$unit: no $key="
+  done
 done
 
 # What the unit checks before starting: the installed example is valid.
