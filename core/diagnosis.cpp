@@ -21,24 +21,33 @@ int Context::response_delay(std::size_t j, std::size_t i) const {
   return g.delay + leading;
 }
 
-OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std::vector<Vec>& X) {
+OutputFit fit_output(const Context& cx, std::size_t j, Vec c0, std::vector<Vec> X) {
   const OutputState& o = cx.out[j];
   OutputFit f;
   f.output = j;
   const bool joint = !o.signals.empty();
   const Vec& w0 = joint ? o.wbase : o.wd;
-  Vec target = c0.size() ? Vec(w0 - simulate(o.whitener, c0)) : w0;
-  std::vector<Vec> regs;
+  // The whitened columns are the only N-long temporaries; the output's own
+  // (w0, its whitened signals) are read in place.
+  Vec wc0;
+  if (c0.size()) wc0 = w0 - simulate(o.whitener, c0);
+  std::vector<Vec> wx;
+  wx.reserve(X.size());
+  for (const Vec& x : X) wx.push_back(simulate(o.whitener, x));
+  std::vector<const Vec*> regs;
   regs.reserve(X.size() + o.wsignals.size());
-  for (const Vec& x : X) regs.push_back(simulate(o.whitener, x));
-  if (joint) regs.insert(regs.end(), o.wsignals.begin(), o.wsignals.end());
-  f.fit = least_squares(target, regs, cx.seg);
+  for (const Vec& x : wx) regs.push_back(&x);
+  if (joint)
+    for (const Vec& s : o.wsignals) regs.push_back(&s);
+  f.fit = least_squares_at(c0.size() ? wc0 : w0, regs, cx.seg);
+  wc0.resize(0);
+  wx.clear();
   f.correction = c0.size() ? c0 : Vec::Zero(o.d.size());
   for (std::size_t l = 0; l < X.size(); ++l) f.correction += f.fit.theta(static_cast<Index>(l)) * X[l];
-  f.fixed = c0;
-  f.regressors = X;
+  f.fixed = std::move(c0);
+  f.regressors = std::move(X);
   if (joint) {
-    const auto nx = static_cast<Index>(X.size()), ns = static_cast<Index>(o.signals.size());
+    const auto nx = static_cast<Index>(f.regressors.size()), ns = static_cast<Index>(o.signals.size());
     f.signal_theta = f.fit.theta.segment(nx, ns);
     for (Index s = 0; s < ns; ++s)
       f.correction += (f.signal_theta(s) - o.signal_theta(s)) * o.signals[static_cast<std::size_t>(s)];
@@ -261,6 +270,7 @@ Context prepare(const Problem& p, const Settings& s) {
     (held ? cx.seg.hold : cx.seg.fit)[static_cast<std::size_t>(k)] = 1;
     ++(held ? cx.seg.hold_n : cx.seg.fit_n);
   }
+  cx.seg.index();
 
   cx.excited.assign(p.inputs.size(), false);
   for (std::size_t i = 0; i < p.inputs.size(); ++i) {

@@ -84,8 +84,10 @@ struct Candidate {
 };
 
 // Fits output j with fixed correction c0 (may be empty) plus linear terms X,
-// jointly with the output's accepted signal regressors.
-OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std::vector<Vec>& X);
+// jointly with the output's accepted signal regressors. c0 and X are taken
+// by value: they become the fit's `fixed` and `regressors`, moved, not
+// copied, when the caller passes temporaries.
+OutputFit fit_output(const Context& cx, std::size_t j, Vec c0, std::vector<Vec> X);
 // -sum n ln(var): the objective to minimise over nonlinear parameters.
 double objective(const Context& cx, const std::vector<OutputFit>& fits);
 // Fills lr, z_hold, hold_gain and lr_beyond_noise.

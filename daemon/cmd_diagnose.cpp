@@ -18,6 +18,7 @@
 #include "daemon/offline.hpp"
 #include "daemon/plant_writer.hpp"
 #include "daemon/report_html.hpp"
+#include "daemon/series_allocator.hpp"
 
 namespace mpm {
 namespace {
@@ -179,6 +180,7 @@ int run(int argc, char** argv) {
       return 0;
     }
     g_quiet = args.flag("quiet");
+    keep_freed_columns_in_heap();
     const std::string plant_path = args.required("plant");
     const std::string data_path = args.required("data");
     if (const auto out = args.get("json")) config::refuse_input_as_output(*out, {plant_path, data_path});
