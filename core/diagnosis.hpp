@@ -46,6 +46,7 @@ struct Settings {
   int max_findings = 8;
   int max_extra_delay = 15;     // dead-time search range (samples)
   bool verbose = false;         // report every candidate through the progress callback
+  std::size_t threads = 1;      // hypothesis generators run on this many threads (same result for any)
 };
 
 struct Problem {

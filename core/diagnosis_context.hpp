@@ -47,6 +47,15 @@ struct Context {
   // has u(k) act after y(k) is read, and a same-sample response in the data
   // can only be the controller's: u(k) is computed from y(k)), else 0.
   int min_input_delay = 0;
+  // Whether make_candidate keeps a candidate's N-long columns (corrections,
+  // regressors, held-out errors) once it is scored. The search over
+  // candidates needs only their numbers, so diagnose() turns this off while
+  // it generates them, then reruns the generator of the one it chooses with
+  // `rebuilding` pointing at it, which keeps that one's columns only: what
+  // the search holds is then a fixed number of columns, not a number that
+  // grows with the candidates tried.
+  bool keep_series = true;
+  const struct Candidate* rebuilding = nullptr;
   std::size_t n_in() const { return problem.inputs.size(); }
   std::size_t n_out() const { return problem.outputs.size(); }
   const std::optional<DiscreteTf>& channel(std::size_t j, std::size_t i) const {
@@ -80,8 +89,17 @@ struct Candidate {
   // The hypothesis fitted jointly with an AR(3) change of the disturbance
   // model, against that change alone: what it explains beyond a wrong N.
   double lr_beyond_noise = 0.0;
+  // Where the candidate came from: the `rank`-th candidate of generator call
+  // `group` (see rebuild_chosen), for a candidate whose columns were released.
+  std::size_t group = 0;
+  std::size_t rank = 0;
   double bic(double log_n) const;  // lr - params ln n
 };
+
+// Drops a scored candidate's N-long columns; its numbers stay.
+void release_series(Candidate& c);
+// Whether make_candidate keeps c's columns (Context::keep_series, rebuilding).
+bool keeps_series(const Context& cx, const Candidate& c);
 
 // Fits output j with fixed correction c0 (may be empty) plus linear terms X,
 // jointly with the output's accepted signal regressors. c0 and X are taken

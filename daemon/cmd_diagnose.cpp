@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "config/output_file.hpp"
@@ -213,6 +214,7 @@ int run(int argc, char** argv) {
     const diagnosis::Problem problem = diagnosis_problem(plant, rec, bound, series, verdict);
     diagnosis::Settings dsettings;
     dsettings.verbose = args.flag("verbose");
+    dsettings.threads = replay_threads(std::thread::hardware_concurrency());
     diagnosis::Result result = diagnosis::diagnose(problem, dsettings, g_quiet ? nullptr : &progress);
     if (verdict.diverging) result.notes.push_back("the monitor finds a diverging loop: its statistics are not trusted");
 
