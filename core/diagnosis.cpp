@@ -87,6 +87,19 @@ double objective(const Context& cx, const std::vector<OutputFit>& fits) {
   return s * static_cast<double>(cx.seg.fit_samples());
 }
 
+double objective(const Context& cx, const OutputFit& fit) {
+  double s = 0.0;
+  s += std::log(fit.fit.fit_var / cx.out[fit.output].fit_var);
+  return s * static_cast<double>(cx.seg.fit_samples());
+}
+
+Candidate make_candidate(const Context& cx, std::string physics, std::vector<Channel> channels, OutputFit fit,
+                         int params) {
+  std::vector<OutputFit> fits;
+  fits.push_back(std::move(fit));
+  return make_candidate(cx, std::move(physics), std::move(channels), std::move(fits), params);
+}
+
 void score(const Context& cx, Candidate& c) {
   c.lr = -objective(cx, c.fits);
   // Out of sample: does the (whitened) correction point along the held-out

@@ -108,6 +108,11 @@ bool keeps_series(const Context& cx, const Candidate& c);
 OutputFit fit_output(const Context& cx, std::size_t j, Vec c0, std::vector<Vec> X);
 // -sum n ln(var): the objective to minimise over nonlinear parameters.
 double objective(const Context& cx, const std::vector<OutputFit>& fits);
+// The same for one output. A call objective(cx, {fit_output(...)}) takes this
+// overload (a braced single fit is an exact match for the aggregate), so the
+// fit's N-long columns are not copied into a vector for every point of a
+// search.
+double objective(const Context& cx, const OutputFit& fit);
 // Fills lr, z_hold, hold_gain and lr_beyond_noise.
 void score(const Context& cx, Candidate& c);
 // Regressors of a change of output j's disturbance model given residual r:
@@ -116,6 +121,10 @@ std::vector<Vec> noise_change_regressors(const Vec& r);
 // A scored candidate of the given physics from its per-output fits.
 Candidate make_candidate(const Context& cx, std::string physics, std::vector<Channel> channels,
                          std::vector<OutputFit> fits, int params);
+// The same for one output's fit, moved in (make_candidate(..., {std::move(f)}, ...)
+// takes this overload: no copy of the fit's columns).
+Candidate make_candidate(const Context& cx, std::string physics, std::vector<Channel> channels, OutputFit fit,
+                         int params);
 // Time constant in samples of a discrete pole in (0, 1); 0 otherwise.
 double tau_of(double pole);
 

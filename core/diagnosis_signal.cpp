@@ -16,14 +16,19 @@ Vec simulate(const DiscreteTf& tf, const Vec& x) {
   DiscreteTf t = tf;
   t.normalise();
   const Index n = x.size();
-  Vec y = Vec::Zero(n);
+  Vec y(n);
   const auto delay = static_cast<Index>(t.delay);
   const double* xs = x.data();
   double* ys = y.data();
   constexpr Index kChunk = 2048;
   for (Index c0 = 0; c0 < n; c0 += kChunk) {
     const Index c1 = std::min(n, c0 + kChunk);
-    for (std::size_t i = 0; i < t.num.size(); ++i) {
+    // step() starts each sample's sum at 0.0 and adds num[0] u(k - delay)
+    // first: so does this (0.0 + v, as there, not v: the same zero's sign).
+    const double b0 = t.num[0];
+    for (Index k = c0; k < std::min(c1, delay); ++k) ys[k] = 0.0;
+    for (Index k = std::max(c0, delay); k < c1; ++k) ys[k] = 0.0 + b0 * xs[k - delay];
+    for (std::size_t i = 1; i < t.num.size(); ++i) {
       const Index lag = delay + static_cast<Index>(i);
       const double b = t.num[i];
       for (Index k = std::max(c0, lag); k < c1; ++k) ys[k] += b * xs[k - lag];
