@@ -35,7 +35,10 @@ OutputFit fit_output(const Context& cx, std::size_t j, Vec c0, std::vector<Vec> 
   // The whitened columns are the only N-long temporaries; the output's own
   // (w0, its whitened signals) are read in place.
   Vec wc0;
-  if (c0.size()) wc0 = w0 - simulate(o.whitener, c0);
+  if (c0.size()) {
+    wc0 = simulate(o.whitener, c0);
+    wc0 = w0 - wc0;  // coefficient-wise, in place
+  }
   std::vector<Vec> wx;
   wx.reserve(X.size());
   for (const Vec& x : X) wx.push_back(simulate(o.whitener, x));

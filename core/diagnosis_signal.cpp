@@ -35,10 +35,22 @@ Vec simulate(const DiscreteTf& tf, const Vec& x) {
     }
   }
   const auto na = static_cast<Index>(t.den.size()) - 1;
-  if (na == 1) {
+  // The recursion is latency-bound: the last outputs are carried in
+  // registers, not reloaded from the stores just made.
+  if (na == 1 && n > 0) {
     const double a1 = t.den[1];
-    for (Index k = 1; k < n; ++k) ys[k] -= a1 * ys[k - 1];
-  } else if (na > 1) {
+    double y1 = ys[0];
+    for (Index k = 1; k < n; ++k) ys[k] = y1 = ys[k] - a1 * y1;
+  } else if (na == 2 && n > 0) {
+    const double a1 = t.den[1], a2 = t.den[2];
+    double y2 = 0.0, y1 = ys[0];
+    if (n > 1) ys[1] = y1 = ys[1] - a1 * (y2 = y1);
+    for (Index k = 2; k < n; ++k) {
+      const double v = ys[k] - a1 * y1 - a2 * y2;
+      y2 = y1;
+      ys[k] = y1 = v;
+    }
+  } else if (na > 2) {
     for (Index k = 0; k < n; ++k) {
       double v = ys[k];
       const Index last = std::min(na, k);

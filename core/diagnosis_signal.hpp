@@ -38,7 +38,8 @@ struct Segments {
   Index hold_samples() const { return hold_n; }
 };
 
-// tf applied to x from rest (x must be finite).
+// tf applied to x from rest (x must be finite): bit for bit what
+// DiscreteFilter::step gives from reset(0), at a cost independent of the delay.
 Vec simulate(const DiscreteTf& tf, const Vec& x);
 // x(k - lag) with zeros before the start (lag may be negative: an advance).
 Vec shifted(const Vec& x, int lag);
