@@ -186,9 +186,9 @@ int run(int argc, char** argv) {
     const std::string data_path = args.required("data");
     if (const auto out = args.get("json")) config::refuse_input_as_output(*out, {plant_path, data_path});
     const PlantModel plant = config::load_plant(plant_path);
-    const config::Recording rec = config::load_recording(data_path);
+    config::Recording rec = config::load_recording(data_path);
     const config::BoundRecording bound = config::bind(plant, rec);
-    const ResidualSeries series = compute_residuals(plant, rec, bound);
+    ResidualSeries series = compute_residuals(plant, rec, bound);
     progress("residuals computed; running the Granger monitor over the record");
 
     MonitorSettings settings;
@@ -212,13 +212,18 @@ int run(int argc, char** argv) {
 
     progress("fitting structured hypotheses");
     const diagnosis::Problem problem = diagnosis_problem(plant, rec, bound, series, verdict);
+    // The fits need only the problem's columns: the recording and the
+    // residual series it was built from are not held while they run.
+    const std::size_t samples = rec.samples();
+    rec.data.resize(0, 0);
+    series = ResidualSeries{};
     diagnosis::Settings dsettings;
     dsettings.verbose = args.flag("verbose");
     dsettings.threads = replay_threads(std::thread::hardware_concurrency());
     diagnosis::Result result = diagnosis::diagnose(problem, dsettings, g_quiet ? nullptr : &progress);
     if (verdict.diverging) result.notes.push_back("the monitor finds a diverging loop: its statistics are not trusted");
 
-    const std::string json = report_json(plant, rec.samples(), monitor, verdict, result);
+    const std::string json = report_json(plant, samples, monitor, verdict, result);
     if (const auto out = args.get("json"))
       config::write_output_file(*out, json);
     else
