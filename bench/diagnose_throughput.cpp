@@ -1,7 +1,6 @@
 #include "bench/diagnose_throughput.hpp"
 
 #include <spawn.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <time.h>
 
@@ -18,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "bench/child_process.hpp"
 #include "config/plant_loader.hpp"
 #include "core/diagnosis.hpp"
 #include "core/granger_monitor.hpp"
@@ -86,7 +86,10 @@ diagnosis::Result diagnose_files(const std::string& plant_path, const std::strin
 extern "C" char** environ;
 
 // Runs `exe diagnose --quiet --plant PLANT --data DATA --json OUT` as a child
-// and returns its maximum resident set in MB (wait4), or nullopt with `why`.
+// and returns its peak resident set in MB, or nullopt with `why`. The peak is
+// the child's VmHWM read from /proc every 10 ms until it exits (wait4's
+// ru_maxrss would not do: it keeps the larger of the child's peak and this
+// process's resident set when the child was spawned).
 std::optional<double> child_peak_rss_mb(const std::string& exe, const std::string& plant_path,
                                         const std::string& data_path, const std::string& out_path,
                                         std::string& why) {
@@ -101,15 +104,22 @@ std::optional<double> child_peak_rss_mb(const std::string& exe, const std::strin
     return std::nullopt;
   }
   int status = 0;
-  rusage ru{};
-  pid_t got = 0;
-  do got = ::wait4(pid, &status, 0, &ru);
-  while (got < 0 && errno == EINTR);
-  if (got != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    why = exe + " diagnose did not exit 0 on the benchmark recording";
+  double peak = 0.0;
+  for (;;) {
+    if (const auto m = read_proc_memory(pid)) peak = std::max(peak, m->vm_hwm_mb);
+    const pid_t got = ::waitpid(pid, &status, WNOHANG);
+    if (got == pid) break;
+    if (got < 0 && errno != EINTR) {
+      why = std::string("waitpid failed: ") + std::strerror(errno);
+      return std::nullopt;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    why = exe + " diagnose " + describe_exit(status) + " on the benchmark recording";
     return std::nullopt;
   }
-  return static_cast<double>(ru.ru_maxrss) / 1024.0;  // ru_maxrss is in kB on Linux
+  return peak;
 }
 
 std::size_t index_of(const std::vector<std::string>& names, const std::string& name) {
@@ -190,7 +200,7 @@ std::optional<DiagnoseThroughput> measure_diagnose(std::size_t samples, std::siz
     } else {
       std::string why_rss;
       r.peak_rss_mb = child_peak_rss_mb(self.string(), plant_path, data_path, dir.file("report.json"), why_rss);
-      r.rss_note = r.peak_rss_mb ? "maximum resident set (wait4 ru_maxrss) of `" + self.string() +
+      r.rss_note = r.peak_rss_mb ? "peak resident set (VmHWM, read every 10 ms) of `" + self.string() +
                                        " diagnose --quiet` run as a child on the same files"
                                  : why_rss;
     }

@@ -4,8 +4,8 @@
 // plant and the recording, bind, residuals, the Granger monitor over the
 // record, the structured hypotheses of core/diagnosis.hpp). Its peak memory
 // is that of the real command: `mpm diagnose` (this program, when it is mpm)
-// run once more as a child on the same files, its maximum resident set read
-// from wait4.
+// run once more as a child on the same files, its peak resident set (VmHWM)
+// read from /proc while it runs.
 #pragma once
 
 #include <cstddef>
