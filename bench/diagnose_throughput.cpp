@@ -1,5 +1,7 @@
 #include "bench/diagnose_throughput.hpp"
 
+#include <spawn.h>
+#include <sys/wait.h>
 #include <time.h>
 
 #include <algorithm>
@@ -11,13 +13,16 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 #include <vector>
 
+#include "bench/child_process.hpp"
 #include "config/plant_loader.hpp"
 #include "core/diagnosis.hpp"
 #include "core/granger_monitor.hpp"
 #include "daemon/offline.hpp"
+#include "daemon/series_allocator.hpp"
 #include "sim/builtin_plants.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/scenarios.hpp"
@@ -73,7 +78,48 @@ diagnosis::Result diagnose_files(const std::string& plant_path, const std::strin
   const RecordVerdict verdict = record_verdict(monitor);
 
   const diagnosis::Problem problem = diagnosis_problem(plant, rec, bound, series, verdict);
-  return diagnosis::diagnose(problem, diagnosis::Settings{}, nullptr);
+  diagnosis::Settings dsettings;
+  dsettings.threads = replay_threads(std::thread::hardware_concurrency());
+  return diagnosis::diagnose(problem, dsettings, nullptr);
+}
+
+extern "C" char** environ;
+
+// Runs `exe diagnose --quiet --plant PLANT --data DATA --json OUT` as a child
+// and returns its peak resident set in MB, or nullopt with `why`. The peak is
+// the child's VmHWM read from /proc every 10 ms until it exits (wait4's
+// ru_maxrss would not do: it keeps the larger of the child's peak and this
+// process's resident set when the child was spawned).
+std::optional<double> child_peak_rss_mb(const std::string& exe, const std::string& plant_path,
+                                        const std::string& data_path, const std::string& out_path,
+                                        std::string& why) {
+  std::vector<std::string> args{exe, "diagnose", "--quiet", "--plant", plant_path, "--data", data_path,
+                                "--json", out_path};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (const int e = posix_spawn(&pid, exe.c_str(), nullptr, nullptr, argv.data(), environ); e != 0) {
+    why = "cannot start " + exe + ": " + std::strerror(e);
+    return std::nullopt;
+  }
+  int status = 0;
+  double peak = 0.0;
+  for (;;) {
+    if (const auto m = read_proc_memory(pid)) peak = std::max(peak, m->vm_hwm_mb);
+    const pid_t got = ::waitpid(pid, &status, WNOHANG);
+    if (got == pid) break;
+    if (got < 0 && errno != EINTR) {
+      why = std::string("waitpid failed: ") + std::strerror(errno);
+      return std::nullopt;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    why = exe + " diagnose " + describe_exit(status) + " on the benchmark recording";
+    return std::nullopt;
+  }
+  return peak;
 }
 
 std::size_t index_of(const std::vector<std::string>& names, const std::string& name) {
@@ -126,6 +172,8 @@ std::optional<DiagnoseThroughput> measure_diagnose(std::size_t samples, std::siz
       config::write_recording(data_path, sim::simulate(loop, samples, data_path));
     }
 
+    // The heap as `mpm diagnose` tunes it (daemon/series_allocator.hpp).
+    keep_freed_columns_in_heap();
     struct Run {
       double wall, cpu;
     };
@@ -142,6 +190,19 @@ std::optional<DiagnoseThroughput> measure_diagnose(std::size_t samples, std::siz
         for (const auto& f : result.findings) r.findings += (r.findings.empty() ? "" : "; ") + f.summary;
         if (result.findings.empty()) r.findings = "no finding";
       }
+    }
+    // Peak memory of the command itself: only when this program is mpm
+    // (`mpm bench`), whose diagnose subcommand is the pipeline timed above.
+    std::error_code ec;
+    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+    if (ec || self.filename() != "mpm") {
+      r.rss_note = "not measured: this program is not mpm (run `mpm bench`)";
+    } else {
+      std::string why_rss;
+      r.peak_rss_mb = child_peak_rss_mb(self.string(), plant_path, data_path, dir.file("report.json"), why_rss);
+      r.rss_note = r.peak_rss_mb ? "peak resident set (VmHWM, read every 10 ms) of `" + self.string() +
+                                       " diagnose --quiet` run as a child on the same files"
+                                 : why_rss;
     }
     std::sort(runs.begin(), runs.end(), [](const Run& a, const Run& b) { return a.wall < b.wall; });
     const Run& median = runs[runs.size() / 2];

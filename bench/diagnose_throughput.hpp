@@ -2,7 +2,10 @@
 // with a planted mismatch (scenario wood-berry-g21-gain) written to temporary
 // files, then the command's whole pipeline timed on it (load and parse the
 // plant and the recording, bind, residuals, the Granger monitor over the
-// record, the structured hypotheses of core/diagnosis.hpp).
+// record, the structured hypotheses of core/diagnosis.hpp). Its peak memory
+// is that of the real command: `mpm diagnose` (this program, when it is mpm)
+// run once more as a child on the same files, its peak resident set (VmHWM)
+// read from /proc while it runs.
 #pragma once
 
 #include <cstddef>
@@ -23,6 +26,8 @@ struct DiagnoseThroughput {
   std::string planted;                 // "y2 <- u1": the scenario's edited channels
   bool found_planted = false;          // every run's findings name every planted channel
   std::string findings;                // the findings' summaries, "; "-separated
+  std::optional<double> peak_rss_mb;   // the `mpm diagnose` child's maximum resident set, MB
+  std::string rss_note;                // how it was measured, or why not
 };
 
 // Simulates `samples` samples of the scenario (seed 1, as `mpm simulate`

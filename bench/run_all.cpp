@@ -220,7 +220,7 @@ void replay_figure(Plan& plan, std::int64_t& allocations, std::size_t& updates) 
 // `mpm diagnose` end to end on a recording with a planted mismatch: only a
 // diagnosis that names the planted channel gives a figure.
 void diagnose_figure(Plan& plan) {
-  const std::size_t samples = plan.quick() ? 3000 : 50000;
+  const std::size_t samples = plan.quick() ? 3000 : 1000000;
   const std::size_t repeats = plan.quick() ? 1 : 3;
   plan.say("mpm diagnose pipeline on " + std::to_string(samples) + " closed-loop Wood-Berry samples");
   const std::string name = "diagnose_samples_per_s_2x2";
@@ -236,7 +236,7 @@ void diagnose_figure(Plan& plan) {
                 "temporary files, then diagnosed as `mpm diagnose --quiet` does, by the same library calls in this "
                 "process (not the mpm binary; the same daemon/offline functions as the command): load and "
                 "parse plant YAML and CSV, bind, residuals, Granger monitor (forgetting 1) over %zu threads, "
-                "structured hypotheses (core/diagnosis.hpp); JSON report not timed; wall-clock, median of %zu "
+                "structured hypotheses (core/diagnosis.hpp, generators on every core); JSON report not timed; wall-clock, median of %zu "
                 "runs (fastest %.0f samples/s; %.2f s wall, %.2f s process CPU)",
                 d->samples, d->scenario.c_str(), d->threads, d->repeats, d->fastest_samples_per_s, d->wall_seconds,
                 d->cpu_seconds);
@@ -249,6 +249,8 @@ void diagnose_figure(Plan& plan) {
   }
   plan.add(name, d->samples_per_s, "samples/s",
            note + "; the diagnosis named the planted channel " + d->planted + ": " + d->findings);
+  plan.add("diagnose_peak_rss_mb_2x2", d->peak_rss_mb, "MB",
+           std::to_string(d->samples) + "-sample recording as above: " + d->rss_note);
 }
 
 void lcm_figures(Plan& plan) {

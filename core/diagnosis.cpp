@@ -2,9 +2,14 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <exception>
 #include <cmath>
 #include <limits>
+#include <functional>
 #include <set>
+#include <thread>
+#include <stdexcept>
 
 #include "core/chi_square.hpp"
 #include "core/diagnosis_context.hpp"
@@ -21,24 +26,36 @@ int Context::response_delay(std::size_t j, std::size_t i) const {
   return g.delay + leading;
 }
 
-OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std::vector<Vec>& X) {
+OutputFit fit_output(const Context& cx, std::size_t j, Vec c0, std::vector<Vec> X) {
   const OutputState& o = cx.out[j];
   OutputFit f;
   f.output = j;
   const bool joint = !o.signals.empty();
   const Vec& w0 = joint ? o.wbase : o.wd;
-  Vec target = c0.size() ? Vec(w0 - simulate(o.whitener, c0)) : w0;
-  std::vector<Vec> regs;
+  // The whitened columns are the only N-long temporaries; the output's own
+  // (w0, its whitened signals) are read in place.
+  Vec wc0;
+  if (c0.size()) {
+    wc0 = simulate(o.whitener, c0);
+    wc0 = w0 - wc0;  // coefficient-wise, in place
+  }
+  std::vector<Vec> wx;
+  wx.reserve(X.size());
+  for (const Vec& x : X) wx.push_back(simulate(o.whitener, x));
+  std::vector<const Vec*> regs;
   regs.reserve(X.size() + o.wsignals.size());
-  for (const Vec& x : X) regs.push_back(simulate(o.whitener, x));
-  if (joint) regs.insert(regs.end(), o.wsignals.begin(), o.wsignals.end());
-  f.fit = least_squares(target, regs, cx.seg);
+  for (const Vec& x : wx) regs.push_back(&x);
+  if (joint)
+    for (const Vec& s : o.wsignals) regs.push_back(&s);
+  f.fit = least_squares_at(c0.size() ? wc0 : w0, regs, cx.seg);
+  wc0.resize(0);
+  wx.clear();
   f.correction = c0.size() ? c0 : Vec::Zero(o.d.size());
   for (std::size_t l = 0; l < X.size(); ++l) f.correction += f.fit.theta(static_cast<Index>(l)) * X[l];
-  f.fixed = c0;
-  f.regressors = X;
+  f.fixed = std::move(c0);
+  f.regressors = std::move(X);
   if (joint) {
-    const auto nx = static_cast<Index>(X.size()), ns = static_cast<Index>(o.signals.size());
+    const auto nx = static_cast<Index>(f.regressors.size()), ns = static_cast<Index>(o.signals.size());
     f.signal_theta = f.fit.theta.segment(nx, ns);
     for (Index s = 0; s < ns; ++s)
       f.correction += (f.signal_theta(s) - o.signal_theta(s)) * o.signals[static_cast<std::size_t>(s)];
@@ -48,12 +65,42 @@ OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std:
   return f;
 }
 
+void release_series(Candidate& c) {
+  for (OutputFit& f : c.fits) {
+    f.correction.resize(0);
+    f.fixed.resize(0);
+    f.regressors.clear();
+    f.regressors.shrink_to_fit();
+    f.fit.hold_error.resize(0);
+  }
+}
+
+bool keeps_series(const Context& cx, const Candidate& c) {
+  if (cx.keep_series) return true;
+  const Candidate* r = cx.rebuilding;
+  return r && r->lr == c.lr && r->finding.physics == c.finding.physics && r->params == c.params &&
+         r->z_hold == c.z_hold;
+}
+
 std::vector<Vec> noise_change_regressors(const Vec& r) { return {shifted(r, 1), shifted(r, 2), shifted(r, 3)}; }
 
 double objective(const Context& cx, const std::vector<OutputFit>& fits) {
   double s = 0.0;
   for (const auto& f : fits) s += std::log(f.fit.fit_var / cx.out[f.output].fit_var);
   return s * static_cast<double>(cx.seg.fit_samples());
+}
+
+double objective(const Context& cx, const OutputFit& fit) {
+  double s = 0.0;
+  s += std::log(fit.fit.fit_var / cx.out[fit.output].fit_var);
+  return s * static_cast<double>(cx.seg.fit_samples());
+}
+
+Candidate make_candidate(const Context& cx, std::string physics, std::vector<Channel> channels, OutputFit fit,
+                         int params) {
+  std::vector<OutputFit> fits;
+  fits.push_back(std::move(fit));
+  return make_candidate(cx, std::move(physics), std::move(channels), std::move(fits), params);
 }
 
 void score(const Context& cx, Candidate& c) {
@@ -261,6 +308,7 @@ Context prepare(const Problem& p, const Settings& s) {
     (held ? cx.seg.hold : cx.seg.fit)[static_cast<std::size_t>(k)] = 1;
     ++(held ? cx.seg.hold_n : cx.seg.fit_n);
   }
+  cx.seg.index();
 
   cx.excited.assign(p.inputs.size(), false);
   for (std::size_t i = 0; i < p.inputs.size(); ++i) {
@@ -329,16 +377,80 @@ bool overlaps(const std::set<std::pair<std::size_t, long>>& used, const Finding&
   return false;
 }
 
+// The generator calls of one round, in order: each candidate is tagged with
+// its call and its rank in it, so that the chosen one can be rebuilt with its
+// columns (the search keeps only numbers: Context::keep_series). The calls
+// only read the context, so those queued since the last flush run on
+// Settings::threads threads; their candidates are appended in call order,
+// whatever the threads did first.
+using Group = std::function<void(std::vector<Candidate>&)>;
+struct Groups {
+  std::vector<Group> calls;
+  std::size_t flushed = 0;
+  void add(Group g) { calls.push_back(std::move(g)); }
+  void flush(std::vector<Candidate>& all, std::size_t threads) {
+    const std::size_t first = flushed, count = calls.size() - flushed;
+    flushed = calls.size();
+    std::vector<std::vector<Candidate>> got(count);
+    std::vector<std::exception_ptr> failed(count);
+    std::atomic<std::size_t> next{0};
+    const auto work = [&] {
+      for (std::size_t g = next++; g < count; g = next++) try {
+          calls[first + g](got[g]);
+        } catch (...) {
+          failed[g] = std::current_exception();
+        }
+    };
+    std::vector<std::thread> pool;
+    for (std::size_t t = 1; t < std::min(threads, count); ++t) pool.emplace_back(work);
+    work();
+    for (std::thread& t : pool) t.join();
+    for (std::size_t g = 0; g < count; ++g) {
+      if (failed[g]) std::rethrow_exception(failed[g]);
+      for (std::size_t k = 0; k < got[g].size(); ++k) {
+        got[g][k].group = first + g;
+        got[g][k].rank = k;
+        all.push_back(std::move(got[g][k]));
+      }
+    }
+  }
+};
+
+// The chosen candidate again, its generator rerun keeping its columns only:
+// the fits are deterministic, so it is the same candidate.
+Candidate rebuild_chosen(Context& cx, const Groups& groups, const Candidate& chosen) {
+  const bool keep = cx.keep_series;
+  cx.keep_series = false;
+  cx.rebuilding = &chosen;
+  std::vector<Candidate> again;
+  groups.calls.at(chosen.group)(again);
+  cx.rebuilding = nullptr;
+  cx.keep_series = keep;
+  if (again.size() <= chosen.rank || again[chosen.rank].lr != chosen.lr ||
+      again[chosen.rank].finding.physics != chosen.finding.physics)
+    throw std::logic_error("diagnosis: the chosen candidate did not rebuild the same");
+  Candidate c = std::move(again[chosen.rank]);
+  c.group = chosen.group;
+  c.rank = chosen.rank;
+  return c;
+}
+
 std::vector<Candidate> generate(const Context& cx, const std::set<std::pair<std::size_t, long>>& used,
-                                const std::set<std::pair<std::size_t, std::size_t>>& used_signals, Progress progress) {
+                                const std::set<std::pair<std::size_t, std::size_t>>& used_signals, Groups& groups,
+                                Progress progress) {
   std::vector<Candidate> all;
   for (std::size_t j = 0; j < cx.n_out(); ++j)
     for (std::size_t i = 0; i < cx.n_in(); ++i)
-      if (!used.count({j, static_cast<long>(i)})) channel_hypotheses(cx, j, i, all);
+      if (!used.count({j, static_cast<long>(i)}))
+        groups.add([&cx, j, i](std::vector<Candidate>& o) { channel_hypotheses(cx, j, i, o); });
+  groups.flush(all, cx.settings.threads);
   if (progress) progress("channel hypotheses fitted");
-  for (std::size_t i = 0; i < cx.n_in(); ++i) column_hypotheses(cx, i, all);
-  for (std::size_t j = 0; j < cx.n_out(); ++j) row_hypotheses(cx, j, all);
-  plant_hypotheses(cx, all);
+  for (std::size_t i = 0; i < cx.n_in(); ++i)
+    groups.add([&cx, i](std::vector<Candidate>& o) { column_hypotheses(cx, i, o); });
+  for (std::size_t j = 0; j < cx.n_out(); ++j)
+    groups.add([&cx, j](std::vector<Candidate>& o) { row_hypotheses(cx, j, o); });
+  groups.add([&cx](std::vector<Candidate>& o) { plant_hypotheses(cx, o); });
+  groups.flush(all, cx.settings.threads);
   if (progress) progress("column and row hypotheses fitted");
   // A loose screen (5 %, plain lags have little power on slow responses):
   // the decision is the structured fit's own test below, Bonferroni-corrected.
@@ -351,8 +463,10 @@ std::vector<Candidate> generate(const Context& cx, const std::set<std::pair<std:
       if (cx.settings.verbose && progress)
         progress(("  Granger test of " + cx.problem.extra_names[static_cast<std::size_t>(c)] + " -> " +
                   cx.problem.outputs[j] + ": LR " + fmt(lr, 4) + " (limit " + fmt(pre, 3) + ")").c_str());
-      if (lr > pre) signal_hypotheses(cx, j, static_cast<std::size_t>(c), all);
+      if (lr > pre)
+        groups.add([&cx, j, c](std::vector<Candidate>& o) { signal_hypotheses(cx, j, static_cast<std::size_t>(c), o); });
     }
+  groups.flush(all, cx.settings.threads);
   std::vector<Candidate> keep;
   for (auto& c : all)
     if (!overlaps(used, c.finding)) keep.push_back(std::move(c));
@@ -496,7 +610,10 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
   double family = 0.0;
   const double log_n = std::log(static_cast<double>(cx.seg.fit_samples()));
   for (int round = 0; round < settings.max_findings; ++round) {
-    std::vector<Candidate> cands = generate(cx, used, used_signals, progress);
+    Groups groups;
+    cx.keep_series = false;
+    std::vector<Candidate> cands = generate(cx, used, used_signals, groups, progress);
+    cx.keep_series = true;
     if (round == 0) family = std::max<double>(1.0, static_cast<double>(cands.size()));
     // A recorded signal that explains the residual goes first: while it is
     // in the residual, the controller moves the inputs to cancel it and any
@@ -523,6 +640,8 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
       }
     }
     if (!best) break;
+    const Candidate chosen = rebuild_chosen(cx, groups, *best);
+    best = &chosen;
     Finding f = best->finding;
     f.fit = fit_numbers(cx, *best, f.raw);
     for (const auto& ch : f.channels) {

@@ -22,6 +22,23 @@
 // tested against the signals-only fit, so it must earn its place conditional
 // on them (the controller moves the inputs to cancel them, so G_M u is
 // correlated with them).
+//
+// Memory and time. What is held is a fixed number of N-long columns (N
+// samples), never a number that grows with the candidates tried: the
+// problem's own (du and u_abs per input, the residual per output, each extra
+// column), the prepared context's (per output: residual, its whitened copy,
+// the process-corrected base and its whitened copy, the held-out errors, two
+// per accepted recorded signal; G_ji du_i per channel; the extra columns),
+// and per generator thread the temporaries of the one fit in progress (its
+// correction, regressors and their whitened copies: about 25 columns at the
+// largest). Candidates keep only their numbers during the search
+// (Context::keep_series); the chosen one is rebuilt with its columns by
+// rerunning its generator, which is deterministic. No column is decimated or
+// capped. Whole-record filtering is DiscreteFilter's arithmetic without its
+// per-sample history shifts (diagnosis_signal.hpp); least squares sum over
+// runs of the fit part in blocks; the generators of one round run on
+// Settings::threads threads, their candidates taken in call order, so the
+// result does not depend on the thread count.
 #pragma once
 
 #include <cstddef>
@@ -46,6 +63,7 @@ struct Settings {
   int max_findings = 8;
   int max_extra_delay = 15;     // dead-time search range (samples)
   bool verbose = false;         // report every candidate through the progress callback
+  std::size_t threads = 1;      // hypothesis generators run on this many threads (same result for any)
 };
 
 struct Problem {

@@ -47,6 +47,15 @@ struct Context {
   // has u(k) act after y(k) is read, and a same-sample response in the data
   // can only be the controller's: u(k) is computed from y(k)), else 0.
   int min_input_delay = 0;
+  // Whether make_candidate keeps a candidate's N-long columns (corrections,
+  // regressors, held-out errors) once it is scored. The search over
+  // candidates needs only their numbers, so diagnose() turns this off while
+  // it generates them, then reruns the generator of the one it chooses with
+  // `rebuilding` pointing at it, which keeps that one's columns only: what
+  // the search holds is then a fixed number of columns, not a number that
+  // grows with the candidates tried.
+  bool keep_series = true;
+  const struct Candidate* rebuilding = nullptr;
   std::size_t n_in() const { return problem.inputs.size(); }
   std::size_t n_out() const { return problem.outputs.size(); }
   const std::optional<DiscreteTf>& channel(std::size_t j, std::size_t i) const {
@@ -80,14 +89,30 @@ struct Candidate {
   // The hypothesis fitted jointly with an AR(3) change of the disturbance
   // model, against that change alone: what it explains beyond a wrong N.
   double lr_beyond_noise = 0.0;
+  // Where the candidate came from: the `rank`-th candidate of generator call
+  // `group` (see rebuild_chosen), for a candidate whose columns were released.
+  std::size_t group = 0;
+  std::size_t rank = 0;
   double bic(double log_n) const;  // lr - params ln n
 };
 
+// Drops a scored candidate's N-long columns; its numbers stay.
+void release_series(Candidate& c);
+// Whether make_candidate keeps c's columns (Context::keep_series, rebuilding).
+bool keeps_series(const Context& cx, const Candidate& c);
+
 // Fits output j with fixed correction c0 (may be empty) plus linear terms X,
-// jointly with the output's accepted signal regressors.
-OutputFit fit_output(const Context& cx, std::size_t j, const Vec& c0, const std::vector<Vec>& X);
+// jointly with the output's accepted signal regressors. c0 and X are taken
+// by value: they become the fit's `fixed` and `regressors`, moved, not
+// copied, when the caller passes temporaries.
+OutputFit fit_output(const Context& cx, std::size_t j, Vec c0, std::vector<Vec> X);
 // -sum n ln(var): the objective to minimise over nonlinear parameters.
 double objective(const Context& cx, const std::vector<OutputFit>& fits);
+// The same for one output. A call objective(cx, {fit_output(...)}) takes this
+// overload (a braced single fit is an exact match for the aggregate), so the
+// fit's N-long columns are not copied into a vector for every point of a
+// search.
+double objective(const Context& cx, const OutputFit& fit);
 // Fills lr, z_hold, hold_gain and lr_beyond_noise.
 void score(const Context& cx, Candidate& c);
 // Regressors of a change of output j's disturbance model given residual r:
@@ -96,6 +121,10 @@ std::vector<Vec> noise_change_regressors(const Vec& r);
 // A scored candidate of the given physics from its per-output fits.
 Candidate make_candidate(const Context& cx, std::string physics, std::vector<Channel> channels,
                          std::vector<OutputFit> fits, int params);
+// The same for one output's fit, moved in (make_candidate(..., {std::move(f)}, ...)
+// takes this overload: no copy of the fit's columns).
+Candidate make_candidate(const Context& cx, std::string physics, std::vector<Channel> channels, OutputFit fit,
+                         int params);
 // Time constant in samples of a discrete pole in (0, 1); 0 otherwise.
 double tau_of(double pole);
 

@@ -231,6 +231,7 @@ Candidate make_candidate(const Context& cx, std::string physics, std::vector<Cha
   c.finding.params = params;
   score(cx, c);
   c.finding.lr = c.lr;
+  if (!keeps_series(cx, c)) release_series(c);
   return c;
 }
 

@@ -2,14 +2,62 @@
 
 #include <cmath>
 #include <complex>
+#include <utility>
 
 namespace mpm::diagnosis {
 
 Vec simulate(const DiscreteTf& tf, const Vec& x) {
-  DiscreteFilter f(tf);
-  f.reset(0.0);
-  Vec y(x.size());
-  for (Index k = 0; k < x.size(); ++k) y(k) = f.step(x(k));
+  // The same arithmetic as DiscreteFilter::step from rest, term by term in
+  // the same order (so bit for bit the same output), but over the whole
+  // record at once: the numerator's terms as vector passes over cache-sized
+  // chunks, then the denominator's recursion in one scalar loop. step()
+  // shifts its histories every sample, which costs O(delay) per sample; here
+  // a delay costs nothing.
+  DiscreteTf t = tf;
+  t.normalise();
+  const Index n = x.size();
+  Vec y(n);
+  const auto delay = static_cast<Index>(t.delay);
+  const double* xs = x.data();
+  double* ys = y.data();
+  constexpr Index kChunk = 2048;
+  for (Index c0 = 0; c0 < n; c0 += kChunk) {
+    const Index c1 = std::min(n, c0 + kChunk);
+    // step() starts each sample's sum at 0.0 and adds num[0] u(k - delay)
+    // first: so does this (0.0 + v, as there, not v: the same zero's sign).
+    const double b0 = t.num[0];
+    for (Index k = c0; k < std::min(c1, delay); ++k) ys[k] = 0.0;
+    for (Index k = std::max(c0, delay); k < c1; ++k) ys[k] = 0.0 + b0 * xs[k - delay];
+    for (std::size_t i = 1; i < t.num.size(); ++i) {
+      const Index lag = delay + static_cast<Index>(i);
+      const double b = t.num[i];
+      for (Index k = std::max(c0, lag); k < c1; ++k) ys[k] += b * xs[k - lag];
+    }
+  }
+  const auto na = static_cast<Index>(t.den.size()) - 1;
+  // The recursion is latency-bound: the last outputs are carried in
+  // registers, not reloaded from the stores just made.
+  if (na == 1 && n > 0) {
+    const double a1 = t.den[1];
+    double y1 = ys[0];
+    for (Index k = 1; k < n; ++k) ys[k] = y1 = ys[k] - a1 * y1;
+  } else if (na == 2 && n > 0) {
+    const double a1 = t.den[1], a2 = t.den[2];
+    double y2 = 0.0, y1 = ys[0];
+    if (n > 1) ys[1] = y1 = ys[1] - a1 * (y2 = y1);
+    for (Index k = 2; k < n; ++k) {
+      const double v = ys[k] - a1 * y1 - a2 * y2;
+      y2 = y1;
+      ys[k] = y1 = v;
+    }
+  } else if (na > 2) {
+    for (Index k = 0; k < n; ++k) {
+      double v = ys[k];
+      const Index last = std::min(na, k);
+      for (Index i = 1; i <= last; ++i) v -= t.den[static_cast<std::size_t>(i)] * ys[k - i];
+      ys[k] = v;
+    }
+  }
   return y;
 }
 
@@ -120,19 +168,58 @@ double variance(const Vec& x, const std::vector<char>& mask) {
   return std::max(0.0, s2 / static_cast<double>(n) - m * m);
 }
 
+namespace {
+
+// Maximal runs [first, end) of nonzero entries of mask from `begin` on.
+std::vector<std::pair<Index, Index>> runs_of(const std::vector<char>& mask, Index begin) {
+  std::vector<std::pair<Index, Index>> runs;
+  const auto n = static_cast<Index>(mask.size());
+  for (Index k = std::max<Index>(begin, 0); k < n; ++k) {
+    if (!mask[static_cast<std::size_t>(k)]) continue;
+    if (runs.empty() || runs.back().second != k) runs.push_back({k, k});
+    runs.back().second = k + 1;
+  }
+  return runs;
+}
+
+// Rows of the normal equations are summed over blocks of this many samples
+// (one block of every column stays in L1).
+constexpr Index kBlock = 256;
+
+}  // namespace
+
+void Segments::index() {
+  fit_runs = runs_of(fit, begin);
+  hold_runs = runs_of(hold, begin);
+  indexed = true;
+}
+
 LinearFit least_squares(const Vec& target, const std::vector<Vec>& regressors, const Segments& seg) {
-  const std::vector<char>& fit = seg.fit;
-  const std::vector<char>& hold = seg.hold;
+  std::vector<const Vec*> cols;
+  cols.reserve(regressors.size());
+  for (const Vec& x : regressors) cols.push_back(&x);
+  return least_squares_at(target, cols, seg);
+}
+
+LinearFit least_squares_at(const Vec& target, const std::vector<const Vec*>& regressors, const Segments& seg) {
+  Segments local;
+  if (!seg.indexed) {
+    local.fit_runs = runs_of(seg.fit, seg.begin);
+    local.hold_runs = runs_of(seg.hold, seg.begin);
+  }
+  const auto& fit_runs = seg.indexed ? seg.fit_runs : local.fit_runs;
+  const auto& hold_runs = seg.indexed ? seg.hold_runs : local.hold_runs;
   const auto p = static_cast<Index>(regressors.size());
-  // Normal equations on centred data (the intercept): p is 1-3 here.
+  const auto x = [&](Index i) -> const Vec& { return *regressors[static_cast<std::size_t>(i)]; };
+  // Normal equations on centred data (the intercept): p is 1-7 here, and the
+  // centring keeps them as well conditioned as the regressors themselves.
   Index n = 0;
   double ty = 0.0;
   Vec tx = Vec::Zero(p);
-  for (Index k = seg.begin; k < target.size(); ++k) {
-    if (!fit[static_cast<std::size_t>(k)]) continue;
-    ++n;
-    ty += target(k);
-    for (Index i = 0; i < p; ++i) tx(i) += regressors[static_cast<std::size_t>(i)](k);
+  for (const auto& [first, end] : fit_runs) {
+    n += end - first;
+    ty += target.segment(first, end - first).sum();
+    for (Index i = 0; i < p; ++i) tx(i) += x(i).segment(first, end - first).sum();
   }
   LinearFit out;
   out.theta = Vec::Zero(p);
@@ -141,50 +228,55 @@ LinearFit least_squares(const Vec& target, const std::vector<Vec>& regressors, c
   const double my = ty / static_cast<double>(n);
   const Vec mx = tx / static_cast<double>(n);
   if (p > 0) {
-    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(p, p);
-    Vec b = Vec::Zero(p);
-    Vec row(p);
-    for (Index k = seg.begin; k < target.size(); ++k) {
-      if (!fit[static_cast<std::size_t>(k)]) continue;
-      for (Index i = 0; i < p; ++i) row(i) = regressors[static_cast<std::size_t>(i)](k) - mx(i);
-      A.selfadjointView<Eigen::Lower>().rankUpdate(row);
-      b += row * (target(k) - my);
-    }
-    A = A.selfadjointView<Eigen::Lower>();
-    out.theta = A.ldlt().solve(b);
+    // [X - mx, y - my] block by block: its Gram matrix holds A and b.
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(p + 1, p + 1);
+    Eigen::MatrixXd B(kBlock, p + 1);
+    for (const auto& [first, end] : fit_runs)
+      for (Index k = first; k < end; k += kBlock) {
+        const Index m = std::min(kBlock, end - k);
+        for (Index i = 0; i < p; ++i) B.col(i).head(m) = x(i).segment(k, m).array() - mx(i);
+        B.col(p).head(m) = target.segment(k, m).array() - my;
+        G.selfadjointView<Eigen::Lower>().rankUpdate(B.topRows(m).transpose());
+      }
+    const Eigen::MatrixXd A = G.topLeftCorner(p, p).selfadjointView<Eigen::Lower>();
+    const Vec b = G.row(p).head(p).transpose();
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
+    out.theta = ldlt.solve(b);
     if (!out.theta.allFinite()) out.theta.setZero();
-    out.theta_se = A.ldlt().solve(Eigen::MatrixXd::Identity(p, p)).diagonal().cwiseMax(0.0).cwiseSqrt();
+    out.theta_se = ldlt.solve(Eigen::MatrixXd::Identity(p, p)).diagonal().cwiseMax(0.0).cwiseSqrt();
   }
-  auto error = [&](Index k) {
-    double e = target(k);
-    for (Index i = 0; i < p; ++i) e -= out.theta(i) * regressors[static_cast<std::size_t>(i)](k);
-    return e;
+  // Errors e = y - X theta over [first, first + m), into e.
+  Eigen::ArrayXd e(kBlock);
+  const auto errors = [&](Index first, Index m) {
+    e.head(m) = target.segment(first, m).array();
+    for (Index i = 0; i < p; ++i) e.head(m) -= out.theta(i) * x(i).segment(first, m).array();
   };
   double s = 0.0, s2 = 0.0;
-  for (Index k = seg.begin; k < target.size(); ++k)
-    if (fit[static_cast<std::size_t>(k)]) {
-      const double e = error(k);
-      s += e;
-      s2 += e * e;
+  for (const auto& [first, end] : fit_runs)
+    for (Index k = first; k < end; k += kBlock) {
+      const Index m = std::min(kBlock, end - k);
+      errors(k, m);
+      s += e.head(m).sum();
+      s2 += e.head(m).square().sum();
     }
   out.fit_var = std::max(1e-300, s2 / static_cast<double>(n) - (s / static_cast<double>(n)) * (s / static_cast<double>(n)));
   if (p > 0) out.theta_se *= std::sqrt(out.fit_var);
   out.hold_error = Vec::Zero(target.size());
   double h = 0.0, h2 = 0.0;
   Index nh = 0;
-  for (Index k = seg.begin; k < target.size(); ++k)
-    if (hold[static_cast<std::size_t>(k)]) {
-      const double e = error(k);
-      out.hold_error(k) = e;
-      h += e;
-      h2 += e * e;
-      ++nh;
+  for (const auto& [first, end] : hold_runs)
+    for (Index k = first; k < end; k += kBlock) {
+      const Index m = std::min(kBlock, end - k);
+      errors(k, m);
+      out.hold_error.segment(k, m) = e.head(m).matrix();
+      h += e.head(m).sum();
+      h2 += e.head(m).square().sum();
+      nh += m;
     }
   if (nh > 1) {
-    const double m = h / static_cast<double>(nh);
-    out.hold_var = std::max(1e-300, h2 / static_cast<double>(nh) - m * m);
-    for (Index k = seg.begin; k < target.size(); ++k)
-      if (hold[static_cast<std::size_t>(k)]) out.hold_error(k) -= m;
+    const double mh = h / static_cast<double>(nh);
+    out.hold_var = std::max(1e-300, h2 / static_cast<double>(nh) - mh * mh);
+    for (const auto& [first, end] : hold_runs) out.hold_error.segment(first, end - first).array() -= mh;
   }
   return out;
 }

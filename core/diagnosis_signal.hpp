@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -25,11 +26,20 @@ struct Segments {
   Index begin = 0;          // first usable sample
   Index fit_n = 0;
   Index hold_n = 0;
+  // The masks as runs of consecutive samples [first, end), from `begin` on:
+  // the fits sum over these (vector operations on contiguous memory). Filled
+  // by index() once the masks are set; a fit on an unindexed Segments
+  // builds them itself.
+  std::vector<std::pair<Index, Index>> fit_runs;
+  std::vector<std::pair<Index, Index>> hold_runs;
+  bool indexed = false;
+  void index();
   Index fit_samples() const { return fit_n; }
   Index hold_samples() const { return hold_n; }
 };
 
-// tf applied to x from rest (x must be finite).
+// tf applied to x from rest (x must be finite): bit for bit what
+// DiscreteFilter::step gives from reset(0), at a cost independent of the delay.
 Vec simulate(const DiscreteTf& tf, const Vec& x);
 // x(k - lag) with zeros before the start (lag may be negative: an advance).
 Vec shifted(const Vec& x, int lag);
@@ -66,6 +76,8 @@ struct LinearFit {
   Vec hold_error;          // full length: mean-removed errors on held-out samples, 0 elsewhere
 };
 LinearFit least_squares(const Vec& target, const std::vector<Vec>& regressors, const Segments& seg);
+// The same on regressors held elsewhere (no copies of N-long columns).
+LinearFit least_squares_at(const Vec& target, const std::vector<const Vec*>& regressors, const Segments& seg);
 
 // Minimises f over a grid and refines the best point by golden section
 // between its neighbours. Returns the argument.

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "config/output_file.hpp"
@@ -19,6 +20,7 @@
 #include "daemon/offline.hpp"
 #include "daemon/plant_writer.hpp"
 #include "daemon/report_html.hpp"
+#include "daemon/series_allocator.hpp"
 
 namespace mpm {
 namespace {
@@ -182,14 +184,15 @@ int run(int argc, char** argv) {
       return 0;
     }
     g_quiet = args.flag("quiet");
+    keep_freed_columns_in_heap();
     const std::string plant_path = args.required("plant");
     const std::string data_path = args.required("data");
     if (const auto out = args.get("json")) config::refuse_input_as_output(*out, {plant_path, data_path});
     const config::Limits limits = limits_from(args);
     const PlantModel plant = config::load_plant(plant_path, limits);
-    const config::Recording rec = config::load_recording(data_path, limits);
+    config::Recording rec = config::load_recording(data_path, limits);
     const config::BoundRecording bound = config::bind(plant, rec);
-    const ResidualSeries series = compute_residuals(plant, rec, bound);
+    ResidualSeries series = compute_residuals(plant, rec, bound);
     progress("residuals computed; running the Granger monitor over the record");
 
     MonitorSettings settings;
@@ -213,12 +216,18 @@ int run(int argc, char** argv) {
 
     progress("fitting structured hypotheses");
     const diagnosis::Problem problem = diagnosis_problem(plant, rec, bound, series, verdict);
+    // The fits need only the problem's columns: the recording and the
+    // residual series it was built from are not held while they run.
+    const std::size_t samples = rec.samples();
+    rec.data.resize(0, 0);
+    series = ResidualSeries{};
     diagnosis::Settings dsettings;
     dsettings.verbose = args.flag("verbose");
+    dsettings.threads = replay_threads(std::thread::hardware_concurrency());
     diagnosis::Result result = diagnosis::diagnose(problem, dsettings, g_quiet ? nullptr : &progress);
     if (verdict.diverging) result.notes.push_back("the monitor finds a diverging loop: its statistics are not trusted");
 
-    const std::string json = report_json(plant, rec.samples(), monitor, verdict, result);
+    const std::string json = report_json(plant, samples, monitor, verdict, result);
     if (const auto out = args.get("json"))
       config::write_output_file(*out, json);
     else

@@ -76,7 +76,8 @@ TEST_F(MpmBench, HasEveryFigureOfTheIssueWithAValueOrAReason) {
   const Parsed p = parse(*json_);
   for (const char* name : {"update_ns_2x2", "update_ns_4x4", "update_ns_20x20", "update_ns_50x50", "batch_ns_2x2",
                            "batch_ratio_2x2", "allocations_per_update", "peak_fraction_50x50",
-                           "replay_samples_per_s_2x2", "diagnose_samples_per_s_2x2", "lcm_latency_p50_us",
+                           "replay_samples_per_s_2x2", "diagnose_samples_per_s_2x2", "diagnose_peak_rss_mb_2x2",
+                           "lcm_latency_p50_us",
                            "lcm_latency_p99_us", "mpmd_rss_mb_2x2", "mpmd_rss_mb_50x50"}) {
     SCOPED_TRACE(name);
     ASSERT_TRUE(p.values.count(name));
@@ -112,6 +113,18 @@ TEST_F(MpmBench, DiagnoseFigureIsOfADiagnosisThatFoundThePlantedChannel) {
   const std::string& note = p.notes.at("diagnose_samples_per_s_2x2");
   ASSERT_TRUE(p.values.at("diagnose_samples_per_s_2x2").has_value()) << note;
   EXPECT_NE(note.find("named the planted channel y2 <- u1"), std::string::npos) << note;
+}
+
+// The diagnose command's peak memory is measured on the real command (the
+// test runs `mpm bench`, so the child is this mpm): a value, and a resident
+// set no process of this size has below 1 MB.
+TEST_F(MpmBench, DiagnosePeakMemoryIsOfTheRealCommand) {
+  const Parsed p = parse(*json_);
+  ASSERT_TRUE(p.values.count("diagnose_peak_rss_mb_2x2"));
+  const std::string& note = p.notes.at("diagnose_peak_rss_mb_2x2");
+  ASSERT_TRUE(p.values.at("diagnose_peak_rss_mb_2x2").has_value()) << note;
+  EXPECT_GT(*p.values.at("diagnose_peak_rss_mb_2x2"), 1.0) << note;
+  EXPECT_NE(note.find("diagnose --quiet"), std::string::npos) << note;
 }
 
 }  // namespace
