@@ -9,11 +9,13 @@
 #pragma once
 
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "config/csv_stream.hpp"
+#include "config/row_source.hpp"
 #include "config/plant_loader.hpp"
 #include "core/mimo_model.hpp"
 #include "daemon/offline.hpp"
@@ -24,9 +26,13 @@ struct StreamedRecord {
   GrangerMonitor monitor;
   std::size_t samples = 0;
   std::size_t transient = 0;
+  std::string notes;  // what the reader skipped (an LCM log), for the user
 };
 
-inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::string& path,
+// Opens the recording again for each pass (daemon/data_input.hpp open_data).
+using RowSourceOpener = std::function<std::unique_ptr<config::RowSource>()>;
+
+inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const RowSourceOpener& open,
                                          const MonitorSettings& settings, bool plain_lags,
                                          const PartSampleCallback& on_sample) {
   // Column indices and names as bind() gives them (its time check runs on
@@ -34,10 +40,12 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
   config::Recording header;
   std::vector<double> row;
   config::BoundRecording bound;
+  std::string path;
   {
-    config::CsvRowReader reader(path);
+    const auto reader = open();
+    path = reader->source();
     header.source = path;
-    header.names = reader.names();
+    header.names = reader->names();
     header.data.resize(0, static_cast<Eigen::Index>(header.names.size()));
     bound = config::bind(plant, header);
   }
@@ -48,9 +56,9 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
   if (have_u0) u0 = plant.operating_point->inputs;
   std::size_t n = 0;
   {
-    config::CsvRowReader reader(path);
+    const auto reader = open();
     double last_t = 0.0;
-    while (reader.next(row)) {
+    while (reader->next(row)) {
       const double t = row[bound.time];
       auto fail = [&](const std::string& what) {
         throw config::ConfigError(path + ":" + std::to_string(n + 2) + ": column 't': " + what);
@@ -80,11 +88,11 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
   bool all_sim = true;
   for (std::size_t j = 0; j < p; ++j) all_sim = all_sim && bound.sim[j].has_value();
   StreamedRecord out{monitor_factory(plant, settings, plain_lags)(OutputRange{}), n,
-                     all_sim ? 0 : settling_samples(plant, 0.01, n / 10)};
+                     all_sim ? 0 : settling_samples(plant, 0.01, n / 10), {}};
   ResidualGenerator gen(plant, u0);
   std::vector<double> u(m), y(p), r(p), d(p);
-  config::CsvRowReader reader(path);
-  for (std::size_t k = 0; reader.next(row); ++k) {
+  const auto reader = open();
+  for (std::size_t k = 0; reader->next(row); ++k) {
     for (std::size_t i = 0; i < m; ++i) u[i] = row[bound.inputs[i]];
     for (std::size_t j = 0; j < p; ++j) y[j] = row[bound.outputs[j]];
     gen.step(u.data(), y.data(), r.data());
@@ -93,6 +101,7 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
     out.monitor.update(u.data(), d.data());
     if (on_sample) on_sample(k, out.monitor);
   }
+  out.notes = reader->notes();
   return out;
 }
 
