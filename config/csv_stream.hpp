@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "config/csv_rows.hpp"
 #include "config/limits.hpp"
 #include "config/row_source.hpp"
 
@@ -22,7 +23,7 @@ class CsvRowReader final : public RowSource {
   // ConfigError naming the file (and line) as load_recording does.
   explicit CsvRowReader(const std::string& path, const Limits& limits = {});
 
-  const std::vector<std::string>& names() const override { return names_; }
+  const std::vector<std::string>& names() const override { return layout_.names; }
   const std::string& source() const override { return source_; }
 
   // The next data row's values (one per column, NaN = missing) into `row`,
@@ -39,7 +40,7 @@ class CsvRowReader final : public RowSource {
   };
   std::string source_;
   std::unique_ptr<std::FILE, Closer> file_;
-  std::vector<std::string> names_;
+  detail::CsvLayout layout_;  // names and dialect, from the header
   std::string buffer_;        // [begin_, buffer_.size()) not yet handed out
   std::size_t begin_ = 0;
   bool eof_ = false;
