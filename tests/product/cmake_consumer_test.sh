@@ -7,12 +7,14 @@ set -eu
 build=$1 src=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
 DESTDIR="$work/root" cmake --install "$build" --prefix /usr --component dev >"$work/install.log"
-for f in usr/lib/cmake/mpm/mpmConfig.cmake usr/lib/cmake/mpm/mpmTargets.cmake usr/include/mpm/core/granger_monitor.hpp \
-         usr/lib/libmpm_core.a; do
-  [ -e "$work/root/$f" ] || { echo "FAIL: not installed: /$f"; cat "$work/install.log"; exit 1; }
+# lib/ or lib/<multiarch>/, as GNUInstallDirs chose for the prefix at configure time.
+config=$(find "$work/root/usr" -name mpmConfig.cmake)
+for f in "$config" "$(dirname "$config")/mpmTargets.cmake" "$work/root/usr/include/mpm/core/granger_monitor.hpp" \
+         "$(find "$work/root/usr" -name libmpm_core.a)"; do
+  [ -n "$f" ] && [ -e "$f" ] || { echo "FAIL: not installed: $f"; cat "$work/install.log"; exit 1; }
 done
 # The installed interface names no build or source folder and no instruction-set flag.
-if grep -n "$src\|$build\|-march" "$work/root/usr/lib/cmake/mpm/"*.cmake; then
+if grep -n "$src\|$build\|-march" "$(dirname "$config")"/*.cmake; then
   echo "FAIL: the exported targets refer to the build tree or carry -march"; exit 1
 fi
 cmake -S "$src/tests/product/consumer" -B "$work/consumer" -DCMAKE_PREFIX_PATH="$work/root/usr" \
