@@ -37,7 +37,7 @@ CsvRowReader::CsvRowReader(const std::string& path, const Limits& limits)
       if (!detail::is_blank_line(more)) detail::parse_csv_header({}, path, limits);  // throws: no name
     throw ConfigError(path + ":1: empty file, expected a header line with column names");
   }
-  names_ = detail::parse_csv_header(header, path, limits);
+  layout_ = detail::parse_csv_header(header, path, limits);
 }
 
 bool CsvRowReader::fill() {
@@ -81,11 +81,11 @@ bool CsvRowReader::next(std::vector<double>& row) {
   if (has_pending_) {
     if (held_blank_ > 0) {  // blank lines before more data are rows, as in load_recording
       --held_blank_;
-      detail::parse_csv_row({}, held_first_line_++, names_, source_, row);
+      detail::parse_csv_row({}, held_first_line_++, layout_, source_, row);
       return true;
     }
     has_pending_ = false;
-    detail::parse_csv_row(pending_, pending_line_, names_, source_, row);
+    detail::parse_csv_row(pending_, pending_line_, layout_, source_, row);
     return true;
   }
   std::string_view line;
@@ -100,7 +100,7 @@ bool CsvRowReader::next(std::vector<double>& row) {
       has_pending_ = true;
       return next(row);
     }
-    detail::parse_csv_row(line, line_, names_, source_, row);
+    detail::parse_csv_row(line, line_, layout_, source_, row);
     return true;
   }
   return false;

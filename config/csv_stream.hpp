@@ -11,23 +11,25 @@
 #include <string_view>
 #include <vector>
 
+#include "config/csv_rows.hpp"
 #include "config/limits.hpp"
+#include "config/row_source.hpp"
 
 namespace mpm::config {
 
-class CsvRowReader {
+class CsvRowReader final : public RowSource {
  public:
   // Opens `path` (a regular file only) and reads its header. Throws
   // ConfigError naming the file (and line) as load_recording does.
   explicit CsvRowReader(const std::string& path, const Limits& limits = {});
 
-  const std::vector<std::string>& names() const { return names_; }
-  const std::string& source() const { return source_; }
+  const std::vector<std::string>& names() const override { return layout_.names; }
+  const std::string& source() const override { return source_; }
 
   // The next data row's values (one per column, NaN = missing) into `row`,
   // resized to names().size(); false at the end of the file. Throws
   // ConfigError for a bad row. Blank lines at the end are ignored.
-  bool next(std::vector<double>& row);
+  bool next(std::vector<double>& row) override;
 
  private:
   bool next_line(std::string_view& line);
@@ -38,7 +40,7 @@ class CsvRowReader {
   };
   std::string source_;
   std::unique_ptr<std::FILE, Closer> file_;
-  std::vector<std::string> names_;
+  detail::CsvLayout layout_;  // names and dialect, from the header
   std::string buffer_;        // [begin_, buffer_.size()) not yet handed out
   std::size_t begin_ = 0;
   bool eof_ = false;

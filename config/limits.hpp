@@ -21,6 +21,7 @@ struct Limits {
   std::size_t max_outputs = 100;           // plant outputs (controlled variables)
   std::size_t max_poly_length = 200;       // coefficients in one num or den
   int max_delay_samples = 1000;            // pure delay of one channel, in samples
+  std::size_t max_states = 50;             // states of a state_space plant (its channels' order)
   std::uint64_t max_yaml_bytes = 64u << 20;  // a plant or daemon config file
   std::size_t max_csv_columns = 10000;     // columns of a recording's header
   std::uint64_t max_csv_bytes = std::uint64_t{16} << 30;  // a whole recording read at once

@@ -117,17 +117,6 @@ double largest_root(const std::vector<double>& ascending) {
 // Roots this close to the unit circle count as on it (as has_integrator does).
 constexpr double kUnitCircleMargin = 1e-9;
 
-// The monitor's residual is y - G u with G run open loop (IMC): for a model
-// pole outside the unit circle it grows without bound and every later fit
-// sees infinities. Integrators (poles on the circle) are fine.
-void check_model_stable(const YamlReader& reader, const Field& den, const DiscreteTf& tf) {
-  const double pole = largest_root(tf.den);
-  if (pole > 1.0 + kUnitCircleMargin)
-    reader.fail(den, "expected a stable or integrating model (poles of magnitude <= 1), got a "
-                     "pole of magnitude " + format_number(pole) +
-                     ": the residual y - G u of an unstable model grows without bound");
-}
-
 void fill_continuous(const YamlReader& reader, const Field& entry, double ts, const Limits& limits,
                      ChannelModel& ch) {
   for (const char* key : {"num", "den", "delay"}) {
@@ -165,6 +154,17 @@ void check_noise_roots(const YamlReader& reader, const Field& entry, const Discr
 }
 
 }  // namespace
+
+// The monitor's residual is y - G u with G run open loop (IMC): for a model
+// pole outside the unit circle it grows without bound and every later fit
+// sees infinities. Integrators (poles on the circle) are fine.
+void check_model_stable(const YamlReader& reader, const Field& den, const DiscreteTf& tf) {
+  const double pole = largest_root(tf.den);
+  if (pole > 1.0 + kUnitCircleMargin)
+    reader.fail(den, "expected a stable or integrating model (poles of magnitude <= 1), got a "
+                     "pole of magnitude " + format_number(pole) +
+                     ": the residual y - G u of an unstable model grows without bound");
+}
 
 ChannelModel read_channel(const YamlReader& reader, const Field& entry, const PlantModel& plant,
                           const Limits& limits) {

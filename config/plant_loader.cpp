@@ -89,7 +89,13 @@ void read_header(const YamlReader& reader, const Field& root, const Limits& limi
 void read_model(const YamlReader& reader, const Field& root, const Limits& limits,
                 PlantModel& plant) {
   const Field model = reader.child(root, "model");
-  if (!model.present()) reader.fail(model, "missing (list the model's channels; [] for none)");
+  const Field state_space = reader.child(root, "state_space");
+  if (state_space.present()) {
+    if (model.present()) reader.fail(model, "give the model as `model:` channels or as `state_space:`, not both");
+    detail::read_state_space(reader, state_space, limits, plant);
+    return;
+  }
+  if (!model.present()) reader.fail(model, "missing (list the model's channels, [] for none, or give state_space:)");
   std::map<std::pair<std::size_t, std::size_t>, std::string> seen;  // channel -> path
   for (std::size_t i = 0, n = reader.list_size(model, true); i < n; ++i) {
     const Field entry = reader.element(model, i);
@@ -104,6 +110,12 @@ void read_model(const YamlReader& reader, const Field& root, const Limits& limit
 
 void read_noise(const YamlReader& reader, const Field& root, const Limits& limits,
                 PlantModel& plant) {
+  const Field state_space = reader.child(root, "state_space");
+  if (state_space.present() && (reader.child(state_space, "G").present() || reader.child(state_space, "Bd").present())) {
+    if (reader.child(root, "noise").present())
+      reader.fail(reader.child(root, "noise"), "the state_space's G and noise already give every output's N");
+    return;
+  }
   plant.noise.assign(plant.outputs.size(), std::nullopt);
   std::vector<std::string> given_by(plant.outputs.size());
   const Field noise = reader.child(root, "noise");
@@ -147,7 +159,7 @@ PlantModel parse_plant(const std::string& yaml_text, const std::string& source_n
   const Field root = reader.root(load_yaml(yaml_text, source_name));
   try {
     reader.check_keys(
-        root, {"plant", "sample_time", "inputs", "outputs", "model", "noise", "operating_point"});
+        root, {"plant", "sample_time", "inputs", "outputs", "model", "state_space", "noise", "operating_point"});
     PlantModel plant;
     read_header(reader, root, limits, plant);
     read_model(reader, root, limits, plant);

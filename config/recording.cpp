@@ -46,83 +46,8 @@ class LineCursor {
   std::size_t number_ = 0;
 };
 
-std::string where(const std::string& source, std::size_t line) {
-  return source + ":" + std::to_string(line) + ": ";
-}
-
-std::size_t count_fields(std::string_view line) {
-  return static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
-}
-
 }  // namespace
 
-namespace detail {
-namespace {
-double parse_field_value(std::string_view field, const std::string& source, std::size_t line,
-                   const std::string& column) {
-  field = trim(field);
-  if (field.empty() || detail::is_nan_word(field)) return std::numeric_limits<double>::quiet_NaN();
-  const auto value = detail::parse_double(field);
-  if (!value || !std::isfinite(*value))
-    throw ConfigError(where(source, line) + "column '" + column +
-                      "': expected a finite number (or an empty field or nan for a missing "
-                      "sample), got '" +
-                      std::string(field) + "'");
-  return *value;
-}
-
-}  // namespace
-
-std::vector<std::string> parse_csv_header(std::string_view line, const std::string& source,
-                                          const Limits& limits) {
-  // Counted before anything is stored: a header of a million columns is an
-  // error here, not a million names and a rows x columns buffer.
-  if (const std::size_t n = count_fields(line); n > limits.max_csv_columns)
-    throw ConfigError(where(source, 1) + "header: expected 1.." +
-                      std::to_string(limits.max_csv_columns) + " columns, got " +
-                      std::to_string(n) + " (the limit is Limits::max_csv_columns)");
-  std::vector<std::string> names;
-  std::map<std::string_view, std::size_t> column_of;
-  std::size_t start = 0;
-  for (std::size_t col = 1;; ++col) {
-    const auto comma = line.find(',', start);
-    const std::string_view name = trim(line.substr(start, comma - start));
-    if (name.empty())
-      throw ConfigError(where(source, 1) + "column " + std::to_string(col) +
-                        " of the header has no name");
-    const auto [it, fresh] = column_of.emplace(name, col);
-    if (!fresh)
-      throw ConfigError(where(source, 1) + "duplicate column name '" + std::string(name) +
-                        "' (columns " + std::to_string(it->second) + " and " + std::to_string(col) +
-                        ")");
-    names.emplace_back(name);
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
-  return names;
-}
-
-void parse_csv_row(std::string_view line, std::size_t line_number,
-                   const std::vector<std::string>& names, const std::string& source,
-                   std::vector<double>& values) {
-  std::size_t start = 0;
-  for (std::size_t col = 0; col < names.size(); ++col) {
-    const auto comma = line.find(',', start);
-    const bool last = col + 1 == names.size();
-    if ((comma == std::string_view::npos) != last)
-      throw ConfigError(where(source, line_number) + "expected " + std::to_string(names.size()) +
-                        " fields (as in the header), got " + std::to_string(count_fields(line)));
-    values.push_back(
-        parse_field_value(line.substr(start, comma - start), source, line_number, names[col]));
-    start = comma + 1;
-  }
-}
-
-bool is_blank_line(std::string_view line) {
-  return line.find_first_not_of(" \t\r") == std::string_view::npos;
-}
-
-}  // namespace detail
 
 namespace {
 
@@ -155,7 +80,8 @@ Recording parse_recording(const std::string& csv_text, const std::string& source
     throw ConfigError(source_name + ":1: empty file, expected a header line with column names");
   Recording rec;
   rec.source = source_name;
-  rec.names = detail::parse_csv_header(lines.next(), source_name, limits);
+  const detail::CsvLayout layout = detail::parse_csv_header(lines.next(), source_name, limits);
+  rec.names = layout.names;
   const std::size_t cols = rec.names.size();
   std::vector<double> values;
   // Every value takes at least one byte of the text (its comma or line
@@ -166,7 +92,7 @@ Recording parse_recording(const std::string& csv_text, const std::string& source
     const std::string_view line = lines.next();
     // A blank line before more data is a row of empty fields, whatever
     // blanks it holds (as CsvRowReader reads it: found by fuzz_csv).
-    detail::parse_csv_row(detail::is_blank_line(line) ? std::string_view{} : line, lines.number(), rec.names,
+    detail::parse_csv_row(detail::is_blank_line(line) ? std::string_view{} : line, lines.number(), layout,
                           source_name, values);
   }
   const auto rows = static_cast<Eigen::Index>(values.size() / cols);

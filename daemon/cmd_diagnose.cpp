@@ -16,6 +16,7 @@
 #include "core/granger_monitor.hpp"
 #include "daemon/args.hpp"
 #include "daemon/command.hpp"
+#include "daemon/data_input.hpp"
 #include "daemon/limit_flags.hpp"
 #include "daemon/offline.hpp"
 #include "daemon/plant_writer.hpp"
@@ -32,11 +33,13 @@ constexpr const char* kUsage =
     "  hypotheses (gain, dead time, time constant, extra lag, integrator, missing channel,\n"
     "  actuator / sensor lag, saturation, deadband, nonlinear gain, unmodelled recorded\n"
     "  signal, disturbance model) on 70 % of the record, checked on the other 30 %.\n"
-    "  Writes the diagnosis JSON (formats.md section 3) to OUT.json, or to stdout.\n"
+    "  Writes the diagnosis JSON (formats.md section 3) to OUT.json, or to stdout. RUN is a\n"
+    "  CSV or an lcm-logger file of the sample channel (told by its content; formats.md 4.4).\n"
     "  Exit status: 0 done, 1 error (also a failed write; OUT.json may not be an input),\n"
     "  2 usage, 3 cannot decide (too few samples with every input and output finite).\n"
     "options:\n"
     "  --json OUT.json   where to write the report (default: standard output)\n"
+    "  --channel NAME    the sample channel of an LCM log (default MPM_SAMPLE)\n"
     "  --write-plant P2.yaml  also write the plant file with the accepted corrections\n"
     "                    applied, each change commented (never the input plant file)\n"
     "  --html REPORT.html  also write a self-contained HTML report (plots, fit %)\n"
@@ -177,7 +180,7 @@ void write_products(const Args& args, const std::string& plant_path, const std::
 
 int run(int argc, char** argv) {
   try {
-    const Args args(argc, argv, with_limit_flags({"plant", "data", "json", "write-plant", "html"}),
+    const Args args(argc, argv, with_limit_flags({"plant", "data", "json", "write-plant", "html", "channel"}),
                     {"help", "quiet", "verbose"});
     if (args.flag("help")) {
       std::fputs(kUsage, stdout);
@@ -190,7 +193,8 @@ int run(int argc, char** argv) {
     if (const auto out = args.get("json")) config::refuse_input_as_output(*out, {plant_path, data_path});
     const config::Limits limits = limits_from(args);
     const PlantModel plant = config::load_plant(plant_path, limits);
-    config::Recording rec = config::load_recording(data_path, limits);
+    config::Recording rec = load_data(
+        data_path, plant, {args.get("channel").value_or("MPM_SAMPLE"), g_quiet ? "" : "mpm diagnose", limits});
     const config::BoundRecording bound = config::bind(plant, rec);
     ResidualSeries series = compute_residuals(plant, rec, bound);
     progress("residuals computed; running the Granger monitor over the record");

@@ -11,6 +11,7 @@
 #include "core/mimo_model.hpp"
 #include "daemon/args.hpp"
 #include "daemon/command.hpp"
+#include "daemon/data_input.hpp"
 #include "daemon/limit_flags.hpp"
 #include "daemon/offline.hpp"
 #include "daemon/stream_monitor.hpp"
@@ -22,8 +23,10 @@ constexpr const char* kUsage =
     "usage: mpm monitor --plant PLANT.yaml --data RUN.csv [options]\n"
     "  Replays the recording through the online monitor and prints, per output and input,\n"
     "  the paper's pairwise index F, the conditional index (other inputs in the model),\n"
-    "  its p-value, the noise-model index gamma and the alarm state.\n"
+    "  its p-value, the noise-model index gamma and the alarm state. RUN is a CSV or an\n"
+    "  lcm-logger file of the sample channel (told by its content; formats.md 4.4).\n"
     "options:\n"
+    "  --channel NAME     the sample channel of an LCM log (default MPM_SAMPLE)\n"
     "  --ar-order N       residual lags na (default 10)\n"
     "  --input-order N    input lags nb (default 10)\n"
     "  --input-pole A|auto  Laguerre pole of the input basis (default 0: plain lags as in\n"
@@ -148,7 +151,7 @@ int run(int argc, char** argv) {
   try {
     const Args args(argc, argv, with_limit_flags({"plant", "data", "ar-order", "input-order", "input-pole", "forgetting",
                                                   "false-alarm", "threads", "false-alarms-per-year", "crossing-constant",
-                                                  "settle-samples"}),
+                                                  "settle-samples", "channel"}),
                     {"json", "events", "plain-lags", "help"});
     if (args.flag("help")) {
       std::fputs(kUsage, stdout);
@@ -164,6 +167,7 @@ int run(int argc, char** argv) {
     settings.detector.crossing_constant = args.number("crossing-constant", settings.detector.crossing_constant);
     const config::Limits limits = limits_from(args);
     const PlantModel plant = config::load_plant(args.required("plant"), limits);
+    const DataOptions data_options{args.get("channel").value_or("MPM_SAMPLE"), "mpm monitor", limits};
     const std::string pole = args.get("input-pole").value_or("0");
     settings.input_pole = pole == "auto" ? dominant_pole(plant) : args.number("input-pole", settings.input_pole);
     if (const std::string e = settings.validate(); !e.empty()) throw UsageError(e);
@@ -190,13 +194,14 @@ int run(int argc, char** argv) {
     std::size_t samples = 0, transient = 0;
     const GrangerMonitor monitor = [&] {
       if (requested_threads <= 1) {
-        StreamedRecord r =
-            monitor_csv_stream(plant, args.required("data"), settings, args.flag("plain-lags"), on_sample, settle, limits);
+        const auto open = [&] { return open_data(args.required("data"), plant, data_options); };
+        StreamedRecord r = monitor_csv_stream(plant, open, settings, args.flag("plain-lags"), on_sample, settle);
+        if (!r.notes.empty()) std::fprintf(stderr, "mpm monitor: %s\n", r.notes.c_str());
         samples = r.samples;
         transient = r.transient;
         return std::move(r.monitor);
       }
-      const config::Recording rec = config::load_recording(args.required("data"), limits);
+      const config::Recording rec = load_data(args.required("data"), plant, data_options);
       const ResidualSeries series = compute_residuals(plant, rec, config::bind(plant, rec), settle);
       samples = rec.samples();
       transient = series.transient;

@@ -9,11 +9,13 @@
 #pragma once
 
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "config/csv_stream.hpp"
+#include "config/row_source.hpp"
 #include "config/plant_loader.hpp"
 #include "core/monitor_front_end.hpp"
 #include "daemon/offline.hpp"
@@ -24,21 +26,26 @@ struct StreamedRecord {
   GrangerMonitor monitor;
   std::size_t samples = 0;
   std::size_t transient = 0;
+  std::string notes;  // what the reader skipped (an LCM log), for the user
 };
 
-inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::string& path,
+// Opens the recording again for each pass (daemon/data_input.hpp open_data).
+using RowSourceOpener = std::function<std::unique_ptr<config::RowSource>()>;
+
+inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const RowSourceOpener& open,
                                          const MonitorSettings& settings, bool plain_lags,
-                                         const PartSampleCallback& on_sample, int settle_samples = -1,
-                                         const config::Limits& limits = {}) {
+                                         const PartSampleCallback& on_sample, int settle_samples = -1) {
   // Column indices and names as bind() gives them (its time check runs on
   // the rows below, with the same message).
   config::Recording header;
   std::vector<double> row;
   config::BoundRecording bound;
+  std::string path;
   {
-    config::CsvRowReader reader(path, limits);
+    const auto reader = open();
+    path = reader->source();
     header.source = path;
-    header.names = reader.names();
+    header.names = reader->names();
     header.data.resize(0, static_cast<Eigen::Index>(header.names.size()));
     bound = config::bind(plant, header);
   }
@@ -48,9 +55,9 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
   std::vector<double> u(m), y(p), sim_y(p), d(p);
   std::size_t n = 0;
   {
-    config::CsvRowReader reader(path, limits);
+    const auto reader = open();
     double last_t = 0.0;
-    while (reader.next(row)) {
+    while (reader->next(row)) {
       const double t = row[bound.time];
       auto fail = [&](const std::string& what) {
         throw config::ConfigError(path + ":" + std::to_string(n + 2) + ": column 't': " + what);
@@ -80,10 +87,10 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
     all_sim = all_sim && use_sim[j];
   }
   const std::size_t settle = settle_length(plant, settle_samples, record_settle_cap(n), all_sim);
-  StreamedRecord out{MonitorBlueprint(plant, settings, plain_lags).build(), n, settle};
+  StreamedRecord out{MonitorBlueprint(plant, settings, plain_lags).build(), n, settle, {}};
   ResidualFrontEnd front(plant, origin.u0(), settle, std::move(use_sim));
-  config::CsvRowReader reader(path, limits);
-  for (std::size_t k = 0; reader.next(row); ++k) {
+  const auto reader = open();
+  for (std::size_t k = 0; reader->next(row); ++k) {
     for (std::size_t i = 0; i < m; ++i) u[i] = row[bound.inputs[i]];
     for (std::size_t j = 0; j < p; ++j) {
       y[j] = row[bound.outputs[j]];
@@ -93,6 +100,7 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const std::str
     out.monitor.update(u.data(), d.data());
     if (on_sample) on_sample(k, out.monitor);
   }
+  out.notes = reader->notes();
   return out;
 }
 
