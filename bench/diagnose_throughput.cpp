@@ -17,7 +17,7 @@
 #include <utility>
 #include <vector>
 
-#include "bench/child_process.hpp"
+#include "tests/support/child_process.hpp"
 #include "config/plant_loader.hpp"
 #include "core/diagnosis.hpp"
 #include "core/granger_monitor.hpp"
@@ -31,6 +31,8 @@ namespace mpm::bench {
 namespace {
 
 namespace fs = std::filesystem;
+using test::describe_exit;
+using test::read_proc_memory;
 
 constexpr const char* kScenario = "wood-berry-g21-gain";
 

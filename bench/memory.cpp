@@ -1,7 +1,7 @@
 // What is specific to measuring mpmd: finding it, the plant and
 // configuration it is given, the samples it is fed over LCM and the figures
 // read from it. Starting, notifying, reading /proc and stopping a child are
-// generic and live in bench/child_process.hpp.
+// generic and live in tests/support/child_process.hpp.
 #include "bench/memory.hpp"
 
 #include <unistd.h>
