@@ -193,16 +193,18 @@ std::optional<DiagnoseThroughput> measure_diagnose(std::size_t samples, std::siz
         if (result.findings.empty()) r.findings = "no finding";
       }
     }
-    // Peak memory of the command itself: only when this program is mpm
-    // (`mpm bench`), whose diagnose subcommand is the pipeline timed above.
+    // Peak memory of the command itself: the `mpm` built and installed beside
+    // this program (mpm-bench), whose diagnose subcommand is the pipeline
+    // timed above.
     std::error_code ec;
     const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-    if (ec || self.filename() != "mpm") {
-      r.rss_note = "not measured: this program is not mpm (run `mpm bench`)";
+    const fs::path mpm = ec ? fs::path() : self.parent_path() / "mpm";
+    if (ec || !test::is_executable_file(mpm.string())) {
+      r.rss_note = "not measured: no mpm beside this program (" + (ec ? std::string("/proc/self/exe unreadable") : mpm.string()) + ")";
     } else {
       std::string why_rss;
-      r.peak_rss_mb = child_peak_rss_mb(self.string(), plant_path, data_path, dir.file("report.json"), why_rss);
-      r.rss_note = r.peak_rss_mb ? "peak resident set (VmHWM, read every 10 ms) of `" + self.string() +
+      r.peak_rss_mb = child_peak_rss_mb(mpm.string(), plant_path, data_path, dir.file("report.json"), why_rss);
+      r.rss_note = r.peak_rss_mb ? "peak resident set (VmHWM, read every 10 ms) of `" + mpm.string() +
                                        " diagnose --quiet` run as a child on the same files"
                                  : why_rss;
     }

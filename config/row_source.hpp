@@ -1,5 +1,5 @@
 // A recording read one row at a time, whatever file it came from: the CSV
-// reader (csv_stream.hpp) and the LCM log reader (transport/lcm_log_reader.hpp)
+// reader (csv_stream.hpp) and the LCM log reader (daemon/lcm_log_reader.hpp)
 // both hand out rows of doubles under column names, so the streaming monitor
 // (daemon/stream_monitor.hpp) reads either with the same code.
 #pragma once

@@ -5,7 +5,7 @@
 
 #include "config/csv_stream.hpp"
 #ifdef MPM_HAVE_LCM_LOG
-#include "transport/lcm_log_reader.hpp"
+#include "daemon/lcm_log_reader.hpp"
 #endif
 
 namespace mpm {

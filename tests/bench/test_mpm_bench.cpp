@@ -116,7 +116,7 @@ TEST_F(MpmBench, DiagnoseFigureIsOfADiagnosisThatFoundThePlantedChannel) {
 }
 
 // The diagnose command's peak memory is measured on the real command (the
-// test runs `mpm bench`, so the child is this mpm): a value, and a resident
+// test runs `mpm bench`, so the child is the mpm beside mpm-bench): a value, and a resident
 // set no process of this size has below 1 MB.
 TEST_F(MpmBench, DiagnosePeakMemoryIsOfTheRealCommand) {
   const Parsed p = parse(*json_);

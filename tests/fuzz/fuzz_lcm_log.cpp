@@ -1,5 +1,5 @@
 // Any bytes as an lcm-logger file given to `mpm diagnose --data`
-// (transport/lcm_log_reader.hpp): a recording whose rows hold only finite
+// (daemon/lcm_log_reader.hpp): a recording whose rows hold only finite
 // numbers or NaN, or a ConfigError that names the file and holds no control
 // character (nothing from the file is echoed raw). liblcm's reader sees a
 // frame only after its lengths were checked against the file, so a lying
@@ -12,7 +12,7 @@
 #include <cstdio>
 #include <string>
 
-#include "transport/lcm_log_reader.hpp"
+#include "daemon/lcm_log_reader.hpp"
 
 namespace {
 const mpm::PlantModel& plant() {

@@ -1,4 +1,4 @@
-// lcm-logger files as recordings (transport/lcm_log_reader.hpp): the same
+// lcm-logger files as recordings (daemon/lcm_log_reader.hpp): the same
 // rows as the CSV of the same samples; other channels, other controllers
 // and samples our decoder refuses are counted, never rows; gaps become
 // missing rows; a file that lies about its framing is an error naming the
@@ -15,7 +15,7 @@
 
 #include "config/row_source.hpp"
 #include "lcm_log_files.hpp"
-#include "transport/lcm_log_reader.hpp"
+#include "daemon/lcm_log_reader.hpp"
 
 namespace mpm::transport {
 namespace {

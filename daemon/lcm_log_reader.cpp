@@ -1,4 +1,4 @@
-#include "transport/lcm_log_reader.hpp"
+#include "daemon/lcm_log_reader.hpp"
 
 #include <lcm/eventlog.h>
 #include <sys/stat.h>
