@@ -3,10 +3,13 @@
 every physics word the simulator can make, on random channels, magnitudes and
 seeds, scored as a confusion matrix by word.
 
-usage: scripts/generalisation_bench.py [--mpm build/daemon/mpm] [--runs 200] [--jobs 1] [--seed 1]
+usage: scripts/generalisation_bench.py [--mpm build/daemon/mpm] [--runs 200] [--jobs 1] [--seed 1] [--random-fraction 0.5]
                                        [--out bench.json] [--words gain,deadband]
 
-Each run draws a plant (Wood-Berry, the 3x3, the nonlinear quadruple tank), a
+Each run draws a plant (Wood-Berry, the 3x3, the nonlinear quadruple tank, or
+a random stable plant: 2-4 inputs and outputs, first- and second-order
+channels with delays, some channels absent, its own AR(1) noise models and a
+random MPC tuning, written as a plant file and run by `plant-nominal`), a
 physics word, a channel / input / output and a magnitude from a range, and a
 simulation seed; simulates the closed loop with `mpm simulate` (`--edit` specs,
 a plant file with a changed noise model, a plant file lacking a channel for
@@ -113,6 +116,58 @@ for _p in PLANTS.values():
     _p["inputs"], _p["outputs"], _p["chans"], _p["noise"], _p["text"] = parse_plant(_p["file"])
 
 
+def random_plant(rng, folder):
+    """A random stable plant file (discrete channels, AR(1) noise per output) and its PLANTS entry.
+    The steady-state gain matrix is kept well conditioned (the MPC must be able to hold every
+    setpoint); the move-weight scale, drawn log-uniform over 10^-3..3, varies the tuning from a
+    tight controller whose inputs answer the noise to a calm one."""
+    import math
+    while True:
+        n_in, n_out = rng.randint(2, 4), rng.randint(2, 4)
+        inputs = ["u%d" % (k + 1) for k in range(n_in)]
+        outputs = ["y%d" % (k + 1) for k in range(n_out)]
+        gains = [[0.0] * n_in for _ in range(n_out)]
+        chans, blocks = {}, []
+        for j, o in enumerate(outputs):
+            for i, u in enumerate(inputs):
+                if j != i and rng.random() < 0.25:
+                    continue
+                k = rng.uniform(0.4, 2.0) * rng.choice([-1, 1])
+                tau = math.exp(rng.uniform(math.log(3.0), math.log(40.0)))
+                p1 = math.exp(-1.0 / tau)
+                delay = rng.randint(1, 6)
+                if rng.random() < 0.35:  # second order: a faster second pole
+                    p2 = math.exp(-1.0 / (tau * rng.uniform(0.1, 0.5)))
+                    num = [k * (1 - p1) * (1 - p2)]
+                    den = [1.0, -(p1 + p2), p1 * p2]
+                    chans[(o, u)] = None  # no single pole to move to 1 (the integrator edit)
+                else:
+                    num, den = [k * (1 - p1)], [1.0, -p1]
+                    chans[(o, u)] = p1
+                gains[j][i] = k
+                blocks.append("  - output: %s\n    input: %s\n    num: [%s]\n    den: [%s]\n    delay: %d\n" % (
+                    o, u, ", ".join("%.6g" % x for x in num), ", ".join("%.6g" % x for x in den), delay))
+        try:
+            import numpy
+            sv = numpy.linalg.svd(numpy.array(gains), compute_uv=False)
+            if sv[-1] <= 0 or sv[0] / sv[-1] > 15.0:
+                continue
+        except ImportError:
+            pass
+        noise = {o: rng.uniform(0.5, 0.95) for o in outputs}
+        text = "plant: random\nsample_time: 1\ninputs:  [%s]\noutputs: [%s]\n\nmodel:\n%s\nnoise:\n%s" % (
+            ", ".join(inputs), ", ".join(outputs), "".join(blocks),
+            "".join("  - output: %s\n    num: [1]\n    den: [1, -%.4f]\n    variance: %.4f\n" % (
+                o, noise[o], rng.uniform(0.02, 0.2)) for o in outputs))
+        path = os.path.join(folder, "plant-random.yaml")
+        with open(path, "w") as f:
+            f.write(text)
+        mws = 10 ** rng.uniform(-3.0, 0.5)
+        return {"file": path, "scenario": "plant-nominal", "extra": ["--move-weight-scale", "%.4g" % mws],
+                "samples": 3000, "inputs": inputs, "outputs": outputs, "chans": chans, "noise": noise,
+                "text": text, "desc": "random %dx%d mws %.3g" % (n_out, n_in, mws)}
+
+
 def column(p, i):
     return [(o, i) for o in p["outputs"] if (o, i) in p["chans"]]
 
@@ -148,9 +203,10 @@ def with_noise_pole(p, o, pole, folder, tag):
     return path
 
 
-def draw_case(rng, word, scale):
+def draw_case(rng, word, scale, plants):
     """One random case of `word`: (plant key, sim args, sim plant, diag plant, truth findings, description).
-    `scale` in (0, 1] shrinks the magnitude towards nominal (a redraw after a too visible run)."""
+    `scale` in (0, 1] shrinks the magnitude towards nominal (a redraw after a too visible run).
+    `plants` holds this run's random plant under "rand" when it draws one."""
     def toward(nominal, x):
         return nominal + (x - nominal) * scale
 
@@ -166,9 +222,17 @@ def draw_case(rng, word, scale):
     channel_words = ["gain", "time_constant", "dead_time", "unmodeled_dynamics", "integrator", "missing_channel"]
     keys = ["wb", "tt"] if word in channel_words + ["disturbance_model"] else ["wb", "tt", "qt"]
     key = rng.choice(keys)
-    p = PLANTS[key]
+    if "rand" in plants:
+        key = "rand"
+    p = plants[key]
     if word in channel_words:
-        o, i = rng.choice(sorted(p["chans"]))
+        pool = sorted(p["chans"])
+        if key == "rand" and word in ("time_constant", "integrator"):
+            # the simulator moves the pole of a discrete first-order channel only
+            pool = [c for c in pool if p["chans"][c] is not None]
+            if not pool:
+                return draw_case(rng, word, scale, {k: v for k, v in plants.items() if k != "rand"})
+        o, i = rng.choice(pool)
         ch = "%s.%s." % (o, i)
         truth = [{"physics": word, "channels": [(o, i)]}]
         if word == "gain":
@@ -192,7 +256,9 @@ def draw_case(rng, word, scale):
         elif word == "integrator":
             pole = p["chans"][(o, i)]
             if pole is None or pole < 0.5:
-                return draw_case(rng, word, scale)
+                if key == "rand":
+                    plants = {k: v for k, v in plants.items() if k != "rand"}
+                return draw_case(rng, word, scale, plants)
             edits = [ch + "pole=%.6f" % (1.0 / pole), ch + "gain=%.3f" % toward(1.0, rng.uniform(0.5, 0.9))]
         else:  # missing_channel: the diagnosis's plant file lacks the channel
             return (key, {"edits": []}, None, ("no", o, i), truth, "%s model lacks %s<-%s" % (key, o, i))
@@ -243,26 +309,42 @@ def simulate(mpm, scenario, plant, seed, samples, extra, out):
 
 
 def run_case(args, index):
+    try:
+        return run_case_once(args, index)
+    except RuntimeError as e:  # counted as an error of the run, never stops the benchmark
+        return {"index": index, "word": "?", "plant": "?", "desc": "", "error": str(e)[-300:]}
+
+
+def run_case_once(args, index):
     rng = random.Random(args.seed * 1000003 + index)
     word = "none" if rng.random() < args.none_fraction else rng.choice(args.words)
     sim_seed = rng.randint(1, 10 ** 6)
+    # The random plant has its own stream, so that adding it left the other draws of a
+    # seed as they were (the fixed plants' runs stay comparable with older results).
+    prng = random.Random(args.seed * 7919 + index * 104729 + 17)
     with tempfile.TemporaryDirectory(prefix="mpm_gb_") as tmp:
+        plants = dict(PLANTS)
+        if word not in ("nonlinear_gain", "unmodeled_input") and prng.random() < args.random_fraction:
+            plants["rand"] = random_plant(prng, tmp)
         if word == "none":
-            key = rng.choice(["wb", "tt", "qt"])
-            p = PLANTS[key]
+            key = "rand" if "rand" in plants else rng.choice(["wb", "tt", "qt"])
+            p = plants[key]
             run = os.path.join(tmp, "run.csv")
             simulate(args.mpm, p["scenario"], p["file"], sim_seed, p["samples"], p["extra"], run)
-            return diagnose(args, index, word, key, p["file"], run, [], "%s nominal" % key, sim_seed, 1.0)
+            return diagnose(args, index, word, key, p["file"], run, [], "%s nominal" % p.get("desc", key),
+                            sim_seed, 1.0)
         state = rng.getstate()
         scale, ratio = 1.0, None
         for attempt in range(5):
             rng.setstate(state)
-            key, spec, sim_change, diag_change, truth, desc = draw_case(rng, word, scale)
-            p = PLANTS[key]
+            key, spec, sim_change, diag_change, truth, desc = draw_case(rng, word, scale, plants)
+            p = plants[key]
+            if key == "rand":
+                desc = desc.replace("rand", p["desc"], 1)
             scenario = spec.get("scenario", p["scenario"])
             samples = spec.get("samples", p["samples"])
             extra = p["extra"] if scenario == p["scenario"] or scenario == "plant-nominal" else []
-            if scenario == "plant-nominal" and key != "tt":
+            if scenario == "plant-nominal" and key not in ("tt", "rand"):
                 extra = []
             nominal_run = os.path.join(tmp, "nominal.csv")
             base_scenario = scenario if scenario.startswith("quad-tank-wide") else (
@@ -322,6 +404,7 @@ def score(results):
     conf = defaultdict(Counter)
     tp = fp = fn = 0
     det = det_n = fa = fa_n = right = n_true = errors = 0
+    by_plant = defaultdict(Counter)  # per plant kind (random / fixed): physics right, true findings
     for r in results:
         if "error" in r:
             errors += 1
@@ -355,12 +438,16 @@ def score(results):
                 got = "missed"
             conf[t["physics"]][got] += 1
             right += got == t["physics"]
+            kind = "random" if r["plant"] == "rand" else "fixed"
+            by_plant[kind]["true_findings"] += 1
+            by_plant[kind]["physics_right"] += got == t["physics"]
     prec = tp / (tp + fp) if tp + fp else 1.0
     rec = tp / (tp + fn) if tp + fn else 1.0
     f1 = 2 * prec * rec / (prec + rec) if prec + rec else 0.0
     return {"runs": len(results), "errors": errors, "detect": det, "mismatch_runs": det_n, "false_alarms": fa,
             "nominal_runs": fa_n, "physics_right": right, "true_findings": n_true, "locate_precision": round(prec, 3),
             "locate_recall": round(rec, 3), "locate_f1": round(f1, 3),
+            "by_plant": {k: dict(v) for k, v in by_plant.items()},
             "confusion": {k: dict(v) for k, v in conf.items()}}
 
 
@@ -379,6 +466,8 @@ def print_matrix(s):
           % (s["runs"], s["errors"], s["detect"], s["mismatch_runs"], s["false_alarms"], s["nominal_runs"],
              s["physics_right"], s["true_findings"], 100.0 * s["physics_right"] / max(1, s["true_findings"]),
              s["locate_precision"], s["locate_recall"], s["locate_f1"]))
+    print("  physics by plant: " + ", ".join("%s %d/%d" % (k, v.get("physics_right", 0), v.get("true_findings", 0))
+                                            for k, v in sorted(s.get("by_plant", {}).items())))
 
 
 def main():
@@ -389,6 +478,8 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--words", default=",".join(WORDS), help="comma-separated physics words to draw from")
     ap.add_argument("--none-fraction", type=float, default=0.1, help="share of runs without mismatch")
+    ap.add_argument("--random-fraction", type=float, default=0.5,
+                    help="share of runs on a random plant (words the simulator can edit on any plant)")
     ap.add_argument("--out", default="", help="write the runs and the score as JSON here (never overwritten)")
     ap.add_argument("--verbose", action="store_true", help="one line per run")
     args = ap.parse_args()
@@ -412,7 +503,8 @@ def main():
     if args.out:
         with open(args.out, "w") as f:
             json.dump({"args": {"runs": args.runs, "seed": args.seed, "words": args.words,
-                                "none_fraction": args.none_fraction}, "score": s, "runs": results}, f, indent=1)
+                                "none_fraction": args.none_fraction,
+                                "random_fraction": args.random_fraction}, "score": s, "runs": results}, f, indent=1)
     return 0
 
 
