@@ -208,6 +208,7 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   if (detector_.windows() > 1) {
     info_scratch_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d));
     info_llt_ = factored_identity(static_cast<Eigen::Index>(d));
+    info_last_.assign(n_outputs * detector_.windows(), Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(d), static_cast<Eigen::Index>(d)));
   }
   // The score starts once the factor's memory is full: before, the AR
   // reference and S are estimates from a few hundred samples and the score
@@ -256,6 +257,7 @@ void GrangerMonitor::reset() noexcept {
   std::fill(outlier_run_.begin(), outlier_run_.end(), 0);
   std::fill(screened_.begin(), screened_.end(), 0);
   std::fill(refresh_last_.begin(), refresh_last_.end(), score_start_);
+  for (Eigen::MatrixXd& m : info_last_) m.setZero();
   std::fill(refresh_count_.begin(), refresh_count_.end(), 0);
   refresh_tick_ = 0;
   refresh_cursor_ = 0;
@@ -276,6 +278,7 @@ void GrangerMonitor::reset_output(std::size_t j) noexcept {
   screened_[j] = 0;
   for (std::size_t k = 0; k < detector_.windows(); ++k) {
     refresh_last_[j * detector_.windows() + k] = score_start_;
+    if (!info_last_.empty()) info_last_[j * detector_.windows() + k].setZero();
     refresh_count_[j * detector_.windows() + k] = 0;
   }
   mean_fast_[jj] = 0.0;
@@ -528,22 +531,49 @@ void GrangerMonitor::refresh_long_windows() noexcept {
   } else {
     reg.inputs_information(info_scratch_.data(), d);
   }
-  info_scratch_ /= output_sum_w_[j];  // information per sample
   std::uint64_t& last = refresh_last_[j * kw + k];
   const double gap = static_cast<double>(output_used_[j] - last);
   last = output_used_[j];
+  // The information the gap's samples brought, per sample: the increment
+  // of S over the gap, S_now - lambda^gap S_then (the factor forgets by
+  // lambda per used sample), over the weight S gives those samples. Not
+  // the snapshot S / n: after a loss of excitation (held inputs) S / n
+  // lags the information the score gathers by S's memory 1 / (1 - lambda)
+  // (~ (1 - lambda^t) of it t samples after the inputs move again), so a
+  // long window credited each gap with the snapshot was normalised by too
+  // little information and crossed (the soak: 9 of 100 frozen stretches
+  // raised 80..280 samples after the inputs moved; `GrangerMonitor.
+  // FrozenInputsMovingAgainRaiseNothing`). In steady state both are the
+  // same. The increment is positive semidefinite in exact arithmetic (a
+  // Schur complement is superadditive); when rounding makes it indefinite
+  // (S falling by 1e16 after a loud stretch) the snapshot is used.
+  Eigen::MatrixXd& then = info_last_[j * kw + k];
+  const double lambda = settings_.forgetting;
+  const double decay = std::pow(lambda, gap);
+  const double spread = lambda < 1.0 ? (1.0 - decay) / (1.0 - lambda) : gap;
+  locate_cov_ = info_scratch_;
+  locate_cov_.noalias() -= decay * then;
+  then = info_scratch_;
+  info_llt_.compute(locate_cov_);
+  if (info_llt_.info() == Eigen::Success && spread > 0.0) info_scratch_ = locate_cov_ / spread;
+  else info_scratch_ /= output_sum_w_[j];
   detector_.refresh_information(j, k, info_scratch_, gap);
   // The focused information per sample: v^T S_ab v for every pair of
-  // inputs (locate_x_ as scratch: no allocation).
+  // inputs (locate_x_ as scratch: no allocation), of the gap's increment
+  // for window k and of the snapshot S / n for the first window (J_0 =
+  // V_0 S / n: its weights are the factor's).
   const auto nb = static_cast<Eigen::Index>(nb_);
   const auto dir = focused_dir_.col(static_cast<Eigen::Index>(j));
-  for (std::size_t a = 0; a < n_inputs_; ++a)
-    for (std::size_t b = 0; b < n_inputs_; ++b)
-    {
-      locate_x_.noalias() = info_scratch_.block(static_cast<Eigen::Index>(a) * nb, static_cast<Eigen::Index>(b) * nb, nb, nb) * dir;
-      focused_info_(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = dir.dot(locate_x_);
-    }
+  const auto project = [&](const Eigen::MatrixXd& info, double scale) {
+    for (std::size_t a = 0; a < n_inputs_; ++a)
+      for (std::size_t b = 0; b < n_inputs_; ++b) {
+        locate_x_.noalias() = info.block(static_cast<Eigen::Index>(a) * nb, static_cast<Eigen::Index>(b) * nb, nb, nb) * dir;
+        focused_info_(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = scale * dir.dot(locate_x_);
+      }
+  };
+  project(info_scratch_, 1.0);
   focused_.refresh_information(j, k, focused_info_, gap);
+  project(then, 1.0 / output_sum_w_[j]);
   if (output_used_[j] >= burn_in_ && !loops_[j].diverging) test_focused(j, 0);
   std::uint32_t& count = refresh_count_[j * kw + k];
   if (count < kMinRefreshes) ++count;
@@ -729,6 +759,7 @@ void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
     focused_.adopt_output(part.focused_, j);
     for (std::size_t k = 0; k < detector_.windows(); ++k) {
       refresh_last_[j * detector_.windows() + k] = part.refresh_last_[j * detector_.windows() + k];
+      if (!info_last_.empty()) info_last_[j * detector_.windows() + k] = part.info_last_[j * detector_.windows() + k];
       refresh_count_[j * detector_.windows() + k] = part.refresh_count_[j * detector_.windows() + k];
     }
     mean_fast_[jj] = part.mean_fast_[jj];

@@ -250,6 +250,7 @@ class GrangerMonitor {
     v(refresh_last_); v(refresh_count_); v(refresh_tick_); v(refresh_cursor_);
     detector_.visit_state(v);
     focused_.visit_state(v);
+    for (Eigen::MatrixXd& m : info_last_) v(m);
   }
 
  private:
@@ -346,6 +347,7 @@ class GrangerMonitor {
   Eigen::MatrixXd info_scratch_;               // m nb x m nb
   Eigen::LLT<Eigen::MatrixXd> info_llt_ = factored_identity(0);      // m nb (covariance form: S = P^-1)
   std::vector<std::uint64_t> refresh_last_;    // output_used_ at each pair's last refresh
+  std::vector<Eigen::MatrixXd> info_last_;     // S at each pair's last refresh (m nb x m nb)
   std::vector<std::uint32_t> refresh_count_;   // refreshes since the output's (re)start
   std::uint64_t refresh_tick_ = 0;
   std::size_t refresh_cursor_ = 0;

@@ -151,8 +151,10 @@ class SequentialDetector {
     return sums_.col(static_cast<Eigen::Index>(j * windows() + k)).data();
   }
   // Windows past the first are normalised by their own information J_W (the
-  // ρ_W^2-weighted average of the per-sample information S/n, refreshed
-  // every so often): S alone has the factor's memory, and a window much
+  // ρ_W^2-weighted sum of the per-sample information, refreshed every so
+  // often with what the samples since the last refresh brought: the
+  // monitor passes the increment of S over the gap, not the snapshot S/n,
+  // which lags the score after a loss of excitation): S alone has the factor's memory, and a window much
   // longer than it, normalised by S, saw its statistic inflated by the
   // excitation of setpoint steps S had forgotten (measured by mpm
   // calibrate: crossing constants 6..1400 instead of ~1). Real-time safe.

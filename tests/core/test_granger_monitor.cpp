@@ -2,6 +2,7 @@
 // links, checked for exactly those links; calibration of the test under H0;
 // gaps; and zero heap allocation per update.
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -214,6 +215,52 @@ TEST(GrangerMonitor, AQuietOrLoudStretchDoesNotBlindTheLiveMonitor) {
     }
     EXPECT_TRUE(raised) << scale << ": the mismatch after the stretch was not raised";
   }
+}
+
+// Held inputs (a frozen actuator, a controller in manual) carry no
+// excitation: the inputs' information decays to the prior while the score
+// stops moving. When the inputs move again, every window must still be
+// normalised by the information its own score accumulated. The soak found
+// false raises 80..280 samples after frozen inputs moved again (9 of 100
+// stretches): the long window's information was built from snapshots of the
+// factor's S / n, which after a loss of excitation lags the information
+// the score gathers (S has a memory of 1 / (1 - lambda) samples), so the
+// long window's T was inflated for its first refreshes.
+TEST(GrangerMonitor, FrozenInputsMovingAgainRaiseNothing) {
+  MonitorSettings s;  // the soak's: short memories, two windows
+  s.ar_order = 5;
+  s.input_order = 10;
+  s.forgetting = 0.995;
+  s.detector.windows = 2;
+  // Cycles of 3000 moving samples and 5000 held (S and J_W forget the
+  // inputs' information: lambda^5000 ~ 1e-11, rho_W^10000 ~ 2e-3).
+  const int cycles = 60;
+  int raises = 0, raises_frozen = 0;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  GrangerMonitor m(2, 2, s, wood_berry_noise(5));
+  double noise[2] = {0.0, 0.0}, du[2] = {0.0, 0.0};
+  bool was_raised = false;
+  for (int c = 0; c < cycles; ++c) {
+    for (int k = 0; k < 8000; ++k) {
+      const bool frozen = c > 0 && k < 5000;
+      if (!frozen) du[0] = 5.0 * n(rng), du[1] = 5.0 * n(rng);
+      noise[0] = 0.8 * noise[0] + n(rng);
+      noise[1] = 0.9 * noise[1] + n(rng);
+      const double u[2] = {15.0 + du[0], 12.0 + du[1]};
+      m.update(u, noise);
+      const bool raised = m.loop(0).alarm || m.loop(1).alarm;
+      if (raised && !was_raised) {
+        (frozen ? raises_frozen : raises) += 1;
+        std::printf("raise: cycle %d sample %d (%s) score %.1f threshold %.1f window %.0f\n", c, k,
+                    frozen ? "frozen" : "moving", m.loop(m.loop(0).alarm ? 0 : 1).score,
+                    m.loop(m.loop(0).alarm ? 0 : 1).score_threshold, m.loop(m.loop(0).alarm ? 0 : 1).score_window);
+      }
+      was_raised = raised;
+    }
+  }
+  EXPECT_EQ(raises, 0) << "false raises on a matched plant after frozen inputs moved again (" << cycles << " cycles)";
+  EXPECT_EQ(raises_frozen, 0);
 }
 
 TEST(GrangerMonitor, OneOutlierIsSkippedCountedAndForgotten) {
