@@ -1,6 +1,7 @@
 // The diagnosis's whole-record kernels against independent oracles:
 // simulate() against DiscreteFilter stepped from rest (bit for bit: the
-// kernel claims the same arithmetic in the same order), least_squares()
+// kernel claims the same arithmetic in the same order; to rounding where the
+// build may fuse multiply-adds), least_squares()
 // against a column-pivoting QR of the centred design on the fit samples,
 // and its run-indexed path against the per-sample masks.
 #include <cmath>
@@ -37,6 +38,17 @@ VectorXd stepped(const DiscreteTf& tf, const VectorXd& x) {
   return y;
 }
 
+// With FMA instructions in the build (MPM_NATIVE_ARCH: -march=x86-64-v3),
+// GCC contracts a * b + c into one rounding wherever it can, and it need not
+// do so at the same places in the kernel and in DiscreteFilter: the two then
+// agree to rounding, not to the bit. Without FMA the order of operations is
+// all there is, and the claim is bit for bit.
+#if defined(__FMA__)
+constexpr bool kBitForBit = false;
+#else
+constexpr bool kBitForBit = true;
+#endif
+
 TEST(DiagnosisKernels, SimulateIsDiscreteFilterBitForBit) {
   const std::vector<DiscreteTf> tfs{
       {{0.744}, {1.0, -0.9419}, 2},                       // Wood-Berry G11
@@ -52,9 +64,14 @@ TEST(DiagnosisKernels, SimulateIsDiscreteFilterBitForBit) {
       const VectorXd x = noise(n, 7 + static_cast<unsigned>(t));
       const VectorXd a = dg::simulate(tfs[t], x), b = stepped(tfs[t], x);
       ASSERT_EQ(a.size(), b.size());
-      // Bit for bit, zeros' signs included.
-      EXPECT_EQ(0, n ? std::memcmp(a.data(), b.data(), static_cast<std::size_t>(n) * sizeof(double)) : 0)
-          << "filter " << t << ", " << n << " samples";
+      if (kBitForBit) {
+        // Bit for bit, zeros' signs included.
+        EXPECT_EQ(0, n ? std::memcmp(a.data(), b.data(), static_cast<std::size_t>(n) * sizeof(double)) : 0)
+            << "filter " << t << ", " << n << " samples";
+      } else if (n > 0) {
+        EXPECT_LE((a - b).cwiseAbs().maxCoeff(), 1e-12 * (1.0 + b.cwiseAbs().maxCoeff()))
+            << "filter " << t << ", " << n << " samples";
+      }
     }
 }
 
