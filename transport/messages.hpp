@@ -169,6 +169,16 @@ struct NamedValues {
   Dds dds;
 };
 
+// Deduction guides: aggregate class template argument deduction (C++20,
+// P1816) is in GCC 11 but not in Clang 14, which builds the fuzz targets.
+template <class Get>
+Scalar(Names, Get) -> Scalar<Get>;
+template <class Get, class Length>
+Array(Names, const char*, Get, Length) -> Array<Get, Length>;
+template <class GetNames, class GetValues, class Length, class Dds>
+NamedValues(const char*, const char*, const char*, const char*, const char*, GetNames, GetValues, Length, Dds)
+    -> NamedValues<GetNames, GetValues, Length, Dds>;
+
 // What a message is called on each wire; specialised below.
 template <class M>
 struct Fields;
