@@ -32,9 +32,15 @@ CsvRowReader::CsvRowReader(const std::string& path, const Limits& limits)
     throw ConfigError(path + ":1: empty file, expected a header line with column names");
   if (header.substr(0, 3) == "\xEF\xBB\xBF") header.remove_prefix(3);  // UTF-8 byte order mark
   if (detail::is_blank_line(header)) {
+    // As load_recording: a blank header before more lines is parsed as the
+    // header it is (a lone CR inside it is that error; found by fuzz_csv).
+    const std::string blank_header(header);
     std::string_view more;
     while (next_line(more))
-      if (!detail::is_blank_line(more)) detail::parse_csv_header({}, path, limits);  // throws: no name
+      if (!detail::is_blank_line(more)) {
+        detail::parse_csv_header(blank_header, path, limits);  // throws: CR, or no name
+        detail::parse_csv_header({}, path, limits);             // throws: no name
+      }
     throw ConfigError(path + ":1: empty file, expected a header line with column names");
   }
   layout_ = detail::parse_csv_header(header, path, limits);

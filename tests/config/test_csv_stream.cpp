@@ -34,6 +34,9 @@ TEST(CsvStream, SameErrors) {
   expect_same("t,u1,y1\n0,1,inf\n", "infinite");
   // A blank line of carriage returns before more data (found by fuzz_csv).
   expect_same("1\n\r\r\n1D,2,3\r\n1,,\r\n", "blank_cr_line_before_data");
+  // A header of carriage returns before a line of data: the CR is the error
+  // in both (found by fuzz_csv in the dialect-aware tokenizer).
+  expect_same("\r\r\n'\r\n", "cr_header_before_data");
 }
 
 TEST(CsvStream, RowsAcrossReadChunks) {
