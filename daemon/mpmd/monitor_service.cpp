@@ -171,17 +171,21 @@ void MonitorService::fill_alarm_header(std::size_t output, std::size_t input, st
   alarm_.input_index = static_cast<std::int32_t>(input);
 }
 
+void MonitorService::fill_channel_alarm(std::size_t output, std::size_t input, bool raised) {
+  const ChannelStats& c = monitor_.channel(output, input);
+  fill_alarm_header(output, input, 0, tracker_.last());
+  alarm_.raised = raised;
+  alarm_.f = c.f_conditional;
+  alarm_.p_value = monitor_.p_value(c.lr_conditional);
+  alarm_.gamma = c.gamma;
+}
+
 void MonitorService::republish_raised(const std::string& reason) {
   const std::size_t n_in = plant_.n_inputs();
   for (std::size_t j = 0; j < plant_.n_outputs(); ++j) {
     for (std::size_t i = 0; i < n_in; ++i) {
       if (!edges_.raised(j, i)) continue;
-      const ChannelStats& c = monitor_.channel(j, i);
-      fill_alarm_header(j, i, 0, tracker_.last());
-      alarm_.raised = true;
-      alarm_.f = c.f_conditional;
-      alarm_.p_value = monitor_.p_value(c.lr_conditional);
-      alarm_.gamma = c.gamma;
+      fill_channel_alarm(j, i, true);
       alarm_.physics = physics_[j * n_in + i];
       alarm_.text = "still raised: model-plant mismatch on " + alarm_.input + " -> " + alarm_.output + " (" +
                     reason + ")";
@@ -197,12 +201,7 @@ void MonitorService::retire(const std::string& reason) {
     for (std::size_t i = 0; i < n_in; ++i) {
       if (!edges_.raised(j, i)) continue;
       edges_.lower(j, i);
-      const ChannelStats& c = monitor_.channel(j, i);
-      fill_alarm_header(j, i, 0, tracker_.last());
-      alarm_.raised = false;
-      alarm_.f = c.f_conditional;
-      alarm_.p_value = monitor_.p_value(c.lr_conditional);
-      alarm_.gamma = c.gamma;
+      fill_channel_alarm(j, i, false);
       alarm_.physics.clear();
       alarm_.text = "cleared: " + alarm_.input + " -> " + alarm_.output + " no longer watched by this monitor (" +
                     reason + ")";

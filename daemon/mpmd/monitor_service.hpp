@@ -156,6 +156,9 @@ class MonitorService {
   void check_alarms(const msg::Sample& s);
   void publish_alarm(std::size_t output, std::size_t input, const msg::Sample& s);
   void fill_alarm_header(std::size_t output, std::size_t input, std::int64_t utime, std::int64_t seq);
+  // The header and the channel's whole-record F, p and gamma, stamped with
+  // the last sequence number (a republished or retired alarm).
+  void fill_channel_alarm(std::size_t output, std::size_t input, bool raised);
   void report_sequence(const SequenceTracker::Result& r, const msg::Sample& s, std::int64_t previous_seq,
                        Clock::time_point now);
   void report_malformed(const msg::Sample& s, Clock::time_point now);
