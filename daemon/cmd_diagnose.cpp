@@ -158,7 +158,7 @@ std::string report_json(const PlantModel& plant, std::size_t samples, const Gran
 
 void write_products(const Args& args, const std::string& plant_path, const std::string& data_path,
                     const PlantModel& plant, const diagnosis::Problem& problem, const GrangerMonitor& monitor,
-                    const RecordVerdict& verdict, const diagnosis::Result& result) {
+                    const RecordVerdict& verdict, const diagnosis::Result& result, const DetectorTrace& trace) {
   const auto plant_out = args.get("write-plant"), html_out = args.get("html");
   if (!plant_out && !html_out) return;
   const std::vector<std::string> inputs{plant_path, data_path};
@@ -170,7 +170,7 @@ void write_products(const Args& args, const std::string& plant_path, const std::
     if (!g_quiet) std::fprintf(stderr, "mpm diagnose: corrected plant written to %s\n", plant_out->c_str());
   }
   if (html_out) {
-    write_text_file(*html_out, report_html({plant, corrected, problem, monitor, verdict, result, plant_path, data_path}),
+    write_text_file(*html_out, report_html({plant, corrected, problem, monitor, verdict, result, plant_path, data_path, &trace}),
                     inputs);
     if (!g_quiet) std::fprintf(stderr, "mpm diagnose: HTML report written to %s\n", html_out->c_str());
   }
@@ -201,7 +201,10 @@ int run(int argc, char** argv) {
 
     MonitorSettings settings;
     settings.forgetting = kRecordForgetting;
-    const GrangerMonitor monitor = monitor_record(plant, series, settings, replay_threads(plant.n_outputs()));
+    // The HTML report shows the live detector's statistic over this same run.
+    DetectorTrace trace(plant.n_outputs(), args.get("html") ? static_cast<std::size_t>(series.u.rows()) : 0);
+    const GrangerMonitor monitor = monitor_record(plant, series, settings, replay_threads(plant.n_outputs()), false,
+                                                  args.get("html") ? trace.callback() : PartSampleCallback{});
     const RecordVerdict verdict = record_verdict(monitor);
     // A header-only or all-NaN record leaves every statistic at its prior
     // (F = 0, p = 1): that is no evidence of a match, so say so instead of
@@ -236,7 +239,7 @@ int run(int argc, char** argv) {
       config::write_output_file(*out, json);
     else
       config::write_stdout(json);
-    write_products(args, plant_path, data_path, plant, problem, monitor, verdict, result);
+    write_products(args, plant_path, data_path, plant, problem, monitor, verdict, result, trace);
     return 0;
   } catch (const UsageError& e) {
     std::fprintf(stderr, "mpm diagnose: %s\n%s", e.what(), kUsage);

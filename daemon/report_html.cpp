@@ -5,9 +5,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
+#include "core/monitor_front_end.hpp"
+#include "core/paper_plots.hpp"
 #include "core/transfer_function.hpp"
 
 namespace mpm {
@@ -16,6 +19,9 @@ namespace {
 using Vec = Eigen::VectorXd;
 constexpr int kMaxLag = 30;        // correlation plots: lags shown
 constexpr Eigen::Index kMaxPoints = 2000;  // time plots: points per series (strided)
+constexpr int kPaperArOrder = 20;   // the paper's sweep: AR(d, 1..20)
+constexpr int kPaperInputLags = 2;  // and R(u_i, 0..2)
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string num(double v) {
   if (!std::isfinite(v)) return "null";
@@ -209,7 +215,111 @@ std::string arrow(const ReportInputs& in, const diagnosis::Finding& f) {
   return o;
 }
 
+// Outputs whose loop the monitor located (a channel named, or the loop's
+// joint test rejecting).
+std::vector<std::size_t> located_loops(const ReportInputs& in) {
+  std::vector<std::size_t> out;
+  for (std::size_t j = 0; j < in.plant.n_outputs(); ++j) {
+    bool located = j < in.verdict.loop_mismatch.size() && in.verdict.loop_mismatch[j];
+    for (const auto& [o, i] : in.verdict.located) located = located || o == j;
+    if (located) out.push_back(j);
+  }
+  return out;
+}
+
+// The paper's location plots for each located loop (core/paper_plots.hpp).
+void paper_section(const ReportInputs& in, std::vector<Plot>& plots, std::ostringstream& body) {
+  const PlantModel& p = in.plant;
+  body << "<section id=paper><h2>The paper's location plots, per located loop</h2>\n<p>As Chen, Xie &amp; Su "
+          "(2021) plot them, from batch least squares on the residual with plain lags: the residual variance "
+          "of <i>d\u0303</i> regressed on its own " << kPaperArOrder << " lags or fewer and on 0, 1 or 2 lags of one "
+          "input (their \u201cR(u,nb), AR(d,1\u2013" << kPaperArOrder << ")\u201d curves: where that input does not "
+          "cause the residual, its curves lie on the AR-only one); and the AR part fitted beside each input's "
+          "lags against the coefficients of 1 \u2212 N\u207b\u00b9 (on the channel that carries the mismatch they "
+          "match; elsewhere the AR part over-fits: \u03b3 measures the distance).</p>\n";
+  const std::vector<std::size_t> loops = located_loops(in);
+  if (loops.empty()) body << "<p>No loop located.</p>\n";
+  const auto b = static_cast<Eigen::Index>(in.problem.begin), n = in.problem.du.rows() - b;
+  const auto noise = noise_ar(p, kPaperArOrder);
+  for (std::size_t j : loops) {
+    const OrderSweep w = order_sweep(in.problem.residual.col(static_cast<Eigen::Index>(j)).segment(b, n),
+                                     in.problem.du.middleRows(b, n), kPaperArOrder, kPaperInputLags);
+    body << "<h3>" << esc(p.outputs[j]) << " (" << w.used << " samples fitted)</h3>\n";
+    for (std::size_t i = 0; i < p.n_inputs(); ++i) {
+      Plot v{tag("v", j) + tag("_", i), p.outputs[j] + ": residual variance against AR order, " + p.inputs[i],
+             "AR order na", {}, {}, "colors:['#444','#1f77b4','#d62728'],drawPoints:true,digitsAfterDecimal:4"};
+      for (int nb = 0; nb <= kPaperInputLags; ++nb) v.labels.push_back("R(" + p.inputs[i] + "," + std::to_string(nb) + ")");
+      for (int na = 1; na <= kPaperArOrder; ++na) {
+        std::vector<double> row{double(na)};
+        for (int nb = 0; nb <= kPaperInputLags; ++nb) row.push_back(w.variance[i][nb][na - 1]);
+        v.rows.push_back(std::move(row));
+      }
+      body << "<div class='plot small' id=" << v.id << "></div>\n";
+      plots.push_back(std::move(v));
+    }
+    Plot g{tag("g", j), p.outputs[j] + ": AR coefficients beside each input's " + tag("", kPaperInputLags) +
+                            " lags against 1 \u2212 N\u207b\u00b9",
+           "coefficient (lag)", {}, {}, "drawPoints:true"};
+    g.labels.push_back("1 \u2212 N\u207b\u00b9");
+    for (std::size_t i = 0; i < p.n_inputs(); ++i)
+      g.labels.push_back("beside " + p.inputs[i] + " (\u03b3 " + num(in.monitor.channel(j, i).gamma) + ")");
+    g.options += ",series:{" + js_string(g.labels[0]) + ":{strokePattern:[6,3],strokeWidth:2.5,color:'#000'}}";
+    for (int l = 0; l < kPaperArOrder; ++l) {
+      std::vector<double> row{double(l + 1), noise[j] ? (*noise[j])[static_cast<std::size_t>(l)] : kNaN};
+      for (std::size_t i = 0; i < p.n_inputs(); ++i) row.push_back(w.ar[i][static_cast<std::size_t>(l)]);
+      g.rows.push_back(std::move(row));
+    }
+    body << "<div class=plot id=" << g.id << "></div>\n";
+    plots.push_back(std::move(g));
+  }
+  body << "</section>\n";
+}
+
+// The live detector's statistic over the record (DetectorTrace).
+void detector_section(const ReportInputs& in, std::vector<Plot>& plots, std::ostringstream& body) {
+  if (!in.trace) return;
+  const DetectorTrace& tr = *in.trace;
+  body << "<section id=detector><h2>The live detector's statistic over the record</h2>\n<p>What mpmd and "
+          "<code>mpm monitor</code> compute on these samples: per output, the sequential detector's score "
+          "statistic T<sub>W</sub> over its threshold h<sub>W</sub> (the largest over its windows W; the "
+          "output is raised when it crosses 1), for the test of all inputs' lags and for the focused test of "
+          "each input's gain direction; the largest over every " << tr.stride() << " samples. Log scale.</p>\n";
+  for (std::size_t j = 0; j < in.plant.n_outputs(); ++j) {
+    Plot t{tag("t", j), in.plant.outputs[j] + ": detector statistic T_W / h_W", "t [s]",
+           {"all inputs", "focused", "threshold"}, {},
+           "colors:['#1f77b4','#ff7f0e','#d62728'],logscale:true,series:{'threshold':{strokePattern:[6,3]}}"};
+    for (std::size_t bin = 0; bin < tr.bins(); ++bin) {
+      const double a = tr.all(j, bin), f = tr.focused(j, bin);
+      if (!std::isfinite(a) && !std::isfinite(f)) continue;
+      t.rows.push_back({static_cast<double>(bin * tr.stride()) * in.problem.sample_time, a, f, 1.0});
+    }
+    if (t.rows.empty()) continue;
+    body << "<div class=plot id=" << t.id << "></div>\n";
+    plots.push_back(std::move(t));
+  }
+  body << "</section>\n";
+}
+
 }  // namespace
+
+DetectorTrace::DetectorTrace(std::size_t outputs, std::size_t samples, std::size_t points)
+    : stride_(std::max<std::size_t>(1, (samples + std::max<std::size_t>(points, 1) - 1) / std::max<std::size_t>(points, 1))),
+      bins_((samples + stride_ - 1) / stride_),
+      all_(outputs, std::vector<double>(bins_, kNaN)),
+      focused_(outputs, std::vector<double>(bins_, kNaN)) {}
+
+PartSampleCallback DetectorTrace::callback() {
+  return [this](std::size_t k, const GrangerMonitor& m) {
+    const std::size_t bin = k / stride_;
+    if (bin >= bins_) return;
+    for (std::size_t j = m.first_modelled_output(); j < m.end_modelled_output() && j < all_.size(); ++j) {
+      // 0: no look yet (left NaN); NaN never compares, so the first look wins.
+      if (const double a = detector_evidence(m.detector(), j); a > 0.0 && !(a <= all_[j][bin])) all_[j][bin] = a;
+      if (const double f = detector_evidence(m.focused_detector(), j); f > 0.0 && !(f <= focused_[j][bin]))
+        focused_[j][bin] = f;
+    }
+  };
+}
 
 std::string dygraphs_path() {
   if (const char* e = std::getenv("MPM_DYGRAPHS_JS"); e && *e) return e;
@@ -344,6 +454,9 @@ std::string report_html(const ReportInputs& in) {
     plots.push_back(std::move(s));
   }
   body << "</section>\n";
+
+  paper_section(in, plots, body);
+  detector_section(in, plots, body);
 
   // Granger table.
   body << "<section id=granger><h2>Granger causality per channel (whole record)</h2>\n<table><tr><th>output</th>"
