@@ -215,13 +215,16 @@ std::string arrow(const ReportInputs& in, const diagnosis::Finding& f) {
   return o;
 }
 
-// Outputs whose loop the monitor located (a channel named, or the loop's
-// joint test rejecting).
+// Outputs whose loop has a mismatch, as the JSON's loops[].mismatch: the
+// monitor located it (a channel named, or the loop's joint test rejecting)
+// or a finding names it.
 std::vector<std::size_t> located_loops(const ReportInputs& in) {
   std::vector<std::size_t> out;
   for (std::size_t j = 0; j < in.plant.n_outputs(); ++j) {
     bool located = j < in.verdict.loop_mismatch.size() && in.verdict.loop_mismatch[j];
     for (const auto& [o, i] : in.verdict.located) located = located || o == j;
+    for (const auto& f : in.result.findings)
+      for (const auto& c : f.channels) located = located || c.output == j;
     if (located) out.push_back(j);
   }
   return out;
