@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "config/json_text.hpp"
 #include "config/output_file.hpp"
 #include "config/plant_loader.hpp"
 #include "core/diagnosis.hpp"
@@ -55,39 +56,9 @@ void progress(const char* message) {
 
 // --- JSON writing -----------------------------------------------------------
 
-std::string quoted(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    switch (c) {
-      case '"': o += "\\\""; break;
-      case '\\': o += "\\\\"; break;
-      case '\n': o += "\\n"; break;
-      case '\t': o += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char b[8];
-          std::snprintf(b, sizeof b, "\\u%04x", c);
-          o += b;
-        } else {
-          o += c;
-        }
-    }
-  }
-  return o + "\"";
-}
-
-std::string number(double v) {
-  if (!std::isfinite(v)) return "null";
-  char b[40];
-  std::snprintf(b, sizeof b, "%.8g", v);
-  return b;
-}
-
-std::string number_list(const std::vector<double>& v) {
-  std::string o = "[";
-  for (std::size_t k = 0; k < v.size(); ++k) o += (k ? ", " : "") + number(v[k]);
-  return o + "]";
-}
+std::string quoted(const std::string& s) { return config::json_string(s); }
+std::string number(double v) { return config::json_number(v, 8); }
+std::string number_list(const std::vector<double>& v) { return config::json_number_list(v, 8); }
 
 std::string tf_json(const DiscreteTf& tf, const std::map<std::string, double>& extra = {}) {
   std::string o = "{\"num\": " + number_list(tf.num) + ", \"den\": " + number_list(tf.den) +

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "config/json_text.hpp"
 #include "config/output_file.hpp"
 #include "core/diagnosis_signal.hpp"
 
@@ -25,11 +26,8 @@ std::string short_num(double v) {
   return b;
 }
 
-std::string list(const std::vector<double>& v) {
-  std::string o = "[";
-  for (std::size_t k = 0; k < v.size(); ++k) o += (k ? ", " : "") + num(v[k]);
-  return o + "]";
-}
+// A YAML flow sequence of numbers reads as the JSON list.
+std::string list(const std::vector<double>& v) { return config::json_number_list(v, 10); }
 
 // A YAML scalar: plain where that is unambiguous, double-quoted otherwise.
 std::string scalar(const std::string& s) {

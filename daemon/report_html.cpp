@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "config/json_text.hpp"
 #include "core/monitor_front_end.hpp"
 #include "core/paper_plots.hpp"
 #include "core/transfer_function.hpp"
@@ -23,12 +24,8 @@ constexpr int kPaperArOrder = 20;   // the paper's sweep: AR(d, 1..20)
 constexpr int kPaperInputLags = 2;  // and R(u_i, 0..2)
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::string num(double v) {
-  if (!std::isfinite(v)) return "null";
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
+// Numbers in the page's script and tables: JSON's (null where not finite).
+std::string num(double v) { return config::json_number(v, 6); }
 
 // prefix + n (built by append: GCC 12 warns falsely, -Wrestrict, on
 // "literal" + std::to_string(n)).
