@@ -8,6 +8,7 @@
 #   mpm --version, mpmd --version,
 #   mpm diagnose on a recording simulated by the installed mpm, with the
 #     installed example plant /etc/mpm/wood-berry.yaml (JSON, HTML, corrected plant),
+#     and the HTML report rendered in headless Chromium when it is installed,
 #   mpmd --check on the installed /etc/mpm/mpmd.yaml,
 #   dpkg --root ... -s mpm and -L mpm (what dpkg recorded).
 # usage: scripts/deb_smoke.sh [WORK_DIR]   (default out/deb-smoke; the build in build-deb/)
@@ -38,11 +39,14 @@ echo "== run from the installed paths"
 "$root/usr/bin/mpmd" --version
 # The scenario's plant from the installed share/mpm/config (not this source tree).
 MPM_CONFIG_DIR="$root/usr/share/mpm/config" "$root/usr/bin/mpm" simulate --scenario wood-berry-g21-gain \
-  --samples 3000 --seed 1 --out "$work/run.csv" | sed "s|$work/||g; s|$root||g"
+  --samples 3000 --seed 1 --out "$work/run.csv" | sed "s|$root||g; s|$work/||g"
 "$root/usr/bin/mpm" diagnose --quiet --plant "$root/etc/mpm/wood-berry.yaml" --data "$work/run.csv" \
   --json "$work/diagnosis.json" --html "$work/report.html" --write-plant "$work/corrected.yaml"
 echo "mpm diagnose: exit 0; $(grep -o '"summary": "[^"]*"' "$work/diagnosis.json")"
 echo "  wrote diagnosis.json ($(wc -c <"$work/diagnosis.json") B), report.html ($(wc -c <"$work/report.html") B), corrected.yaml"
+if command -v chromium >/dev/null && [ -x /usr/bin/python3 ]; then  # the report as a browser draws it
+  /usr/bin/python3 "$src/tests/product/render_report.py" "$work/report.html" "$work/report.png" | sed "s|$work/||g"
+fi
 # mpmd.yaml names its plant file relative to /etc/mpm (where the package puts both).
 "$root/usr/bin/mpmd" --config "$root/etc/mpm/mpmd.yaml" --check 2>&1 | sed "s|$root||g"
 echo "ok: the .deb installed into $root and ran"
