@@ -28,7 +28,7 @@ enum class Scope {
 };
 
 // The test a candidate must pass beyond the fit-part likelihood ratio and
-// the held-out confirmation (see passes() in diagnosis.cpp).
+// the held-out confirmation (see passes() in diagnosis_score.cpp).
 enum class Gate {
   beyond_noise,  // also explain the residual beyond an AR(3) change of the disturbance model
   held_out,      // nothing more: a recorded signal is not moved by the controller
