@@ -194,65 +194,29 @@ void static_map(const Context& cx, const Hypothesis& h, std::size_t i, const std
   out.push_back(std::move(c));
 }
 
-// Gain varying with the output's own level: y = G u (1 + b G u) around
-// the working level, over the whole row. A process linearised at one
-// operating point and run away from it has this form (a tank: every gain
-// into it scales with the square root of its level): the level sets the
-// gain of every input into that output at once, which per-input terms cannot
-// say when the inputs move together in closed loop. As the input maps
-// (static_map), a basis around the working level of the model's prediction
-// v = G_M u - mean: the row's linear gains (one per channel), a centred even
-// term v^2 and an odd term v |v| made orthogonal to v; offered only when the
-// nonlinear terms are significant beyond the best linear gains (nested
-// likelihood ratio, 2 degrees of freedom per output, Bonferroni over the
-// rows and the plant form). Over several outputs it is one candidate, so that
-// it is weighed as one explanation against the per-input ones.
+// Gain varying with the output's own level: y = G u (1 + b G u), the
+// correction b (G_M u)^2 over the whole row, one slope b per output. A
+// process linearised at one operating point and run away from it has this
+// form (a tank: every gain into it scales with the square root of its
+// level): the level sets the gain of every input into that output at once,
+// which per-input u^2 terms cannot say when the inputs move together in
+// closed loop. Over several outputs it is one candidate, so that it is
+// weighed as one explanation against the per-input ones.
 void level_gain(const Context& cx, const Hypothesis& h, const std::vector<std::size_t>& js,
                 std::vector<Candidate>& out) {
   std::vector<OutputFit> fits;
   std::vector<Channel> cs;
-  double nested = 0.0;
-  int params = 0;
   for (std::size_t j : js) {
     const RowPrediction row = row_prediction(cx, j);
-    const Vec v = (row.total.array() - fit_mean(cx, row.total)).matrix();
-    Vec even = v.cwiseProduct(v);
-    even.array() -= fit_mean(cx, even);
-    Vec odd = v.cwiseProduct(v.cwiseAbs());
-    double vv = 0.0, ov = 0.0;
-    for (Index k = 0; k < v.size(); ++k)
-      if (cx.seg.fit[static_cast<std::size_t>(k)]) {
-        vv += v(k) * v(k);
-        ov += odd(k) * v(k);
-      }
-    if (vv <= 0.0) return;
-    odd -= (ov / vv) * v;
-    odd.array() -= fit_mean(cx, odd);
-    std::vector<Vec> lin;
-    for (const Channel& ch : row.channels) lin.push_back(cx.gu[j * cx.n_in() + *ch.input]);
-    const OutputFit linear = fit_output(cx, j, Vec(), lin);
-    lin.push_back(std::move(even));
-    lin.push_back(std::move(odd));
-    fits.push_back(fit_output(cx, j, Vec(), std::move(lin)));
-    nested += std::log(linear.fit.fit_var / fits.back().fit.fit_var);
-    params += static_cast<int>(row.channels.size()) + 2;
+    fits.push_back(fit_output(cx, j, Vec(), {row.total.cwiseProduct(row.total)}));
     cs.insert(cs.end(), row.channels.begin(), row.channels.end());
   }
-  nested *= static_cast<double>(cx.seg.fit_samples());
-  double tests = 0.0;
-  for (std::size_t j = 0; j < cx.n_out(); ++j) tests += row_prediction(cx, j).channels.size() >= 2 ? 1.0 : 0.0;
-  tests += tests >= 2.0 ? 1.0 : 0.0;
-  if (nested < chi_square_quantile_upper(cx.settings.alpha / std::max(1.0, tests), 2.0 * static_cast<double>(js.size())))
-    return;
   const auto first = static_cast<std::size_t>(cs[0].input.value());
-  Candidate c = make_candidate(cx, h, cs, std::move(fits), params);
+  Candidate c = make_candidate(cx, h, cs, fits);
   c.finding.nominal = *cx.channel(js[0], first);
   c.finding.fitted = *cx.channel(js[0], first);
-  c.finding.parameters["nonlinear_lr"] = nested;
-  for (std::size_t r = 0; r < js.size(); ++r) {
-    const Index n_lin = c.fits[r].fit.theta.size() - 2;
-    c.finding.parameters["gain_slope_per_unit_" + cx.problem.outputs[js[r]]] = c.fits[r].fit.theta(n_lin);
-  }
+  for (std::size_t r = 0; r < js.size(); ++r)
+    c.finding.parameters["gain_slope_per_unit_" + cx.problem.outputs[js[r]]] = fits[r].fit.theta(0);
   out.push_back(std::move(c));
 }
 
