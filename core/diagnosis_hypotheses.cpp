@@ -119,9 +119,9 @@ void fit_integrator(const Context& cx, const Hypothesis& h, const Site& s, std::
   const bool replaces_pole = p >= 0.5;
   const auto integrating = [&](double gain) {
     if (replaces_pole) return move_pole(g, p, 1.0, gain);
-    DiscreteTf s = series(g, DiscreteTf{{1.0}, {1.0, -1.0}, 0});
-    for (double& b : s.num) b *= gain;
-    return s;
+    DiscreteTf with_integrator = series(g, DiscreteTf{{1.0}, {1.0, -1.0}, 0});
+    for (double& b : with_integrator.num) b *= gain;
+    return with_integrator;
   };
   const DiscreteTf gi = integrating(1.0);
   const Vec xi = simulate(gi, cx.problem.du.col(static_cast<Index>(i)));
