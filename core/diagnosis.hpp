@@ -23,6 +23,14 @@
 // on them (the controller moves the inputs to cancel them, so G_M u is
 // correlated with them).
 //
+// The hypotheses are the rows of one table (diagnosis_table.hpp): physics
+// word, scope, parameter count, where it applies, its fit, its gate and its
+// sentence. The code is split the same way: record preparation
+// (diagnosis_prepare.cpp), scoring (diagnosis_score.cpp), selection
+// (diagnosis.cpp), the fits (diagnosis_hypotheses.cpp: channel;
+// diagnosis_patterns.cpp: column, row, plant, signal; diagnosis_noise.cpp)
+// and the sentences (diagnosis_summary.cpp).
+//
 // Memory and time. What is held is a fixed number of N-long columns (N
 // samples), never a number that grows with the candidates tried: the
 // problem's own (du and u_abs per input, the residual per output, each extra
@@ -49,6 +57,7 @@
 
 #include <Eigen/Dense>
 
+#include "core/diagnosis_physics.hpp"
 #include "core/diagnosis_signal.hpp"
 #include "core/transfer_function.hpp"
 
@@ -97,7 +106,7 @@ struct FitNumbers {
 
 struct Finding {
   std::vector<Channel> channels;
-  std::string physics;
+  std::string physics;  // word(Physics): set only from the hypothesis table's word
   std::optional<std::string> signal;
   std::string summary;
   std::optional<DiscreteTf> nominal;

@@ -3,12 +3,19 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "core/diagnosis.hpp"
 
 namespace mpm::diagnosis {
+
+struct Hypothesis;  // a row of the hypothesis table (diagnosis_table.hpp)
+
+// The numbers a sentence says that are not parameters of the fitted model
+// (a standard error, the nominal time constant, ...).
+using Facts = std::map<std::string, double>;
 
 // One output's current residual and its whitener.
 // Recorded signals accepted as unmodeled inputs of this output stay free in
@@ -80,7 +87,9 @@ struct OutputFit {
 };
 
 struct Candidate {
+  const Hypothesis* hypothesis = nullptr;  // the table row that made it
   Finding finding;
+  Facts facts;  // for the finding's sentence
   std::vector<OutputFit> fits;
   int params = 0;
   double lr = 0.0;        // sum over outputs of n_fit ln(before / after), whitened
@@ -118,23 +127,35 @@ void score(const Context& cx, Candidate& c);
 // Regressors of a change of output j's disturbance model given residual r:
 // r's first three lags (whitened, the lags of the whitened residual: AR(3)).
 std::vector<Vec> noise_change_regressors(const Vec& r);
-// A scored candidate of the given physics from its per-output fits.
-Candidate make_candidate(const Context& cx, std::string physics, std::vector<Channel> channels,
+// A scored candidate of row h from its per-output fits: the parameter count
+// is the row's (Hypothesis::count), or `params` where the fit chooses it.
+Candidate make_candidate(const Context& cx, const Hypothesis& h, std::vector<Channel> channels,
+                         std::vector<OutputFit> fits);
+Candidate make_candidate(const Context& cx, const Hypothesis& h, std::vector<Channel> channels,
                          std::vector<OutputFit> fits, int params);
-// The same for one output's fit, moved in (make_candidate(..., {std::move(f)}, ...)
+// The same for one output's fit, moved in (make_candidate(..., {std::move(f)})
 // takes this overload: no copy of the fit's columns).
-Candidate make_candidate(const Context& cx, std::string physics, std::vector<Channel> channels, OutputFit fit,
-                         int params);
+Candidate make_candidate(const Context& cx, const Hypothesis& h, std::vector<Channel> channels, OutputFit fit);
 // Time constant in samples of a discrete pole in (0, 1); 0 otherwise.
 double tau_of(double pole);
 
-// Hypotheses. Each appends its best-fitting candidate(s).
-void channel_hypotheses(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out);
-void column_hypotheses(const Context& cx, std::size_t i, std::vector<Candidate>& out);
-void row_hypotheses(const Context& cx, std::size_t j, std::vector<Candidate>& out);
-// Hypotheses over every output at once (a gain set by each output's level).
-void plant_hypotheses(const Context& cx, std::vector<Candidate>& out);
-void signal_hypotheses(const Context& cx, std::size_t j, std::size_t column, std::vector<Candidate>& out);
+// Record preparation (diagnosis_prepare.cpp): the usable samples, the fit
+// and held-out blocks, the excited inputs, G_ji du_i per channel, and each
+// output's residual, whitener and scores as they stand.
+Context prepare(const Problem& p, const Settings& s);
+// Whitened variances and held-out errors of output j as it stands: its
+// process-corrected residual less the signals-only fit of its accepted
+// recorded signals.
+void refresh(Context& cx, std::size_t j);
+
+// Selection tests (diagnosis_score.cpp). The fit-part level of the family
+// of `family` candidates; whether c passes the fit, held-out and its row's
+// gate; its selection score (BIC on the fit part plus the held-out
+// log-likelihood gain); the fit block of its finding (and the raw one).
+double fit_level(const Settings& s, double family);
+bool passes(const Candidate& c, const Settings& s, double family);
+double selection_score(const Context& cx, const Candidate& c, double log_n);
+FitNumbers fit_numbers(const Context& cx, const Candidate& c, FitNumbers& raw);
 
 // Granger test of extra column `column` on output j's residual, given the
 // inputs: likelihood ratio (chi-square with `dof`).

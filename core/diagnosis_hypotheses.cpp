@@ -1,20 +1,17 @@
-// The structured hypotheses of the diagnosis: each is a change of the nominal
-// model with one to three physical parameters, fitted by prediction-error
-// minimisation of the whitened residual on the fit part of the record.
+// The channel hypotheses of the diagnosis (one output, one input): each is a
+// change of the nominal model with one to three physical parameters, fitted
+// by prediction-error minimisation of the whitened residual on the fit part
+// of the record. Their rows are in diagnosis_table.cpp, their sentences in
+// diagnosis_summary.cpp.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
-#include "core/diagnosis_context.hpp"
+#include "core/diagnosis_table.hpp"
 
 namespace mpm::diagnosis {
 namespace {
-
-const std::string& in_name(const Context& cx, std::size_t i) { return cx.problem.inputs[i]; }
-const std::string& out_name(const Context& cx, std::size_t j) { return cx.problem.outputs[j]; }
-std::string arrow(const Context& cx, std::size_t j, std::size_t i) { return in_name(cx, i) + " -> " + out_name(cx, j); }
-
 
 // G with its slowest pole p replaced by p2; gain_scale multiplies num.
 DiscreteTf move_pole(const DiscreteTf& g, double p, double p2, double gain_scale) {
@@ -24,23 +21,26 @@ DiscreteTf move_pole(const DiscreteTf& g, double p, double p2, double gain_scale
   return out;
 }
 
-void gain(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+}  // namespace
+
+void fit_gain(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t j = s.output, i = s.input;
   const Vec& x = cx.gu[j * cx.n_in() + i];
   OutputFit f = fit_output(cx, j, Vec(), {x});
   const double k = 1.0 + f.fit.theta(0), se = f.fit.theta_se(0);
-  Candidate c = make_candidate(cx, "gain", {{j, i}}, {std::move(f)}, 1);
+  Candidate c = make_candidate(cx, h, {{j, i}}, {std::move(f)});
   const DiscreteTf& g = *cx.channel(j, i);
   DiscreteTf fitted = g;
   for (double& b : fitted.num) b *= k;
   c.finding.nominal = g;
   c.finding.fitted = fitted;
   c.finding.parameters["gain_factor"] = k;
-  c.finding.summary = "gain of " + arrow(cx, j, i) + " is " + fmt(k) + " x nominal (95% CI " + fmt(k - 1.96 * se) +
-                      "-" + fmt(k + 1.96 * se) + ")";
+  c.facts["gain_factor_se"] = se;
   out.push_back(std::move(c));
 }
 
-void dead_time(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+void fit_dead_time(const Context& cx, const Hypothesis& h, const Site& site, std::vector<Candidate>& out) {
+  const std::size_t j = site.output, i = site.input;
   const Vec& x = cx.gu[j * cx.n_in() + i];
   const DiscreteTf& g = *cx.channel(j, i);
   int best = 0;
@@ -60,21 +60,19 @@ void dead_time(const Context& cx, std::size_t j, std::size_t i, std::vector<Cand
     }
   }
   if (best == 0) return;
-  Candidate c = make_candidate(cx, "dead_time", {{j, i}}, {fit_output(cx, j, shifted(x, best) - x, {})}, 1);
+  Candidate c = make_candidate(cx, h, {{j, i}}, {fit_output(cx, j, shifted(x, best) - x, {})});
   DiscreteTf fitted = g;
   fitted.delay += best;
   c.finding.nominal = g;
   c.finding.fitted = fitted;
   c.finding.parameters["extra_delay_samples"] = best;
-  c.finding.summary = "dead time of " + arrow(cx, j, i) + " is " + std::to_string(fitted.delay) + " samples (" +
-                      fmt(fitted.delay * cx.problem.sample_time) + " s), nominal " + std::to_string(g.delay);
   out.push_back(std::move(c));
 }
 
-void time_constant(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+void fit_time_constant(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t j = s.output, i = s.input;
   const DiscreteTf& g = *cx.channel(j, i);
   const double p = slowest_pole(g);
-  if (p < 0.2) return;
   const Vec& x = cx.gu[j * cx.n_in() + i];
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
   const double tau = tau_of(p);
@@ -86,17 +84,16 @@ void time_constant(const Context& cx, std::size_t j, std::size_t i, std::vector<
   for (int k = 0; k <= 16; ++k) grid.push_back(std::log(0.25) + k * (std::log(4.0) - std::log(0.25)) / 16.0);
   const double lr = minimise_on_grid(grid, [&](double v) { return objective(cx, {fit_output(cx, j, corr(v), {})}); });
   const double p2 = std::exp(-1.0 / (tau * std::exp(lr)));
-  Candidate c = make_candidate(cx, "time_constant", {{j, i}}, {fit_output(cx, j, corr(lr), {})}, 1);
+  Candidate c = make_candidate(cx, h, {{j, i}}, {fit_output(cx, j, corr(lr), {})});
   c.finding.nominal = g;
   c.finding.fitted = move_pole(g, p, p2, (1.0 - p2) / (1.0 - p));
   c.finding.parameters["time_constant_ratio"] = std::exp(lr);
-  c.finding.summary = "dominant time constant of " + arrow(cx, j, i) + " is " + fmt(std::exp(lr)) + " x nominal (" +
-                      fmt(tau * std::exp(lr) * cx.problem.sample_time) + " s vs " + fmt(tau * cx.problem.sample_time) +
-                      " s), gain kept";
+  c.facts["nominal_time_constant_samples"] = tau;
   out.push_back(std::move(c));
 }
 
-void extra_lag(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+void fit_extra_lag(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t j = s.output, i = s.input;
   const DiscreteTf& g = *cx.channel(j, i);
   const Vec& x = cx.gu[j * cx.n_in() + i];
   const double tau_nom = std::max(2.0, tau_of(slowest_pole(g)));
@@ -104,18 +101,16 @@ void extra_lag(const Context& cx, std::size_t j, std::size_t i, std::vector<Cand
   auto corr = [&](double a) { return Vec(simulate(unit_lag(a), x) - x); };
   const double a = minimise_on_grid(grid, [&](double v) { return objective(cx, {fit_output(cx, j, corr(v), {})}); });
   if (a <= 0.0) return;
-  Candidate c = make_candidate(cx, "unmodeled_dynamics", {{j, i}}, {fit_output(cx, j, corr(a), {})}, 1);
+  Candidate c = make_candidate(cx, h, {{j, i}}, {fit_output(cx, j, corr(a), {})});
   c.finding.nominal = g;
   c.finding.fitted = series(g, unit_lag(a));
   c.finding.parameters["extra_lag_pole"] = a;
-  c.finding.summary = arrow(cx, j, i) + " has an extra lag of " + fmt(tau_of(a) * cx.problem.sample_time) +
-                      " s (pole " + fmt(a) + ") the model lacks";
   out.push_back(std::move(c));
 }
 
-void integrator(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+void fit_integrator(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t j = s.output, i = s.input;
   const DiscreteTf& g = *cx.channel(j, i);
-  if (g.has_integrator()) return;
   // Where the channel has a slow mode, the plant integrates in its place
   // (its slowest pole moved to 1, the slope of its first moments kept);
   // where it has none (a fast or static channel), the plant is the channel
@@ -124,9 +119,9 @@ void integrator(const Context& cx, std::size_t j, std::size_t i, std::vector<Can
   const bool replaces_pole = p >= 0.5;
   const auto integrating = [&](double gain) {
     if (replaces_pole) return move_pole(g, p, 1.0, gain);
-    DiscreteTf s = series(g, DiscreteTf{{1.0}, {1.0, -1.0}, 0});
-    for (double& b : s.num) b *= gain;
-    return s;
+    DiscreteTf with_integrator = series(g, DiscreteTf{{1.0}, {1.0, -1.0}, 0});
+    for (double& b : with_integrator.num) b *= gain;
+    return with_integrator;
   };
   const DiscreteTf gi = integrating(1.0);
   const Vec xi = simulate(gi, cx.problem.du.col(static_cast<Index>(i)));
@@ -141,24 +136,17 @@ void integrator(const Context& cx, std::size_t j, std::size_t i, std::vector<Can
   OutputFit f = fit_output(cx, j, -x, {xi, ramp});
   const double k = f.fit.theta(0);
   const double balance = k != 0.0 ? -f.fit.theta(1) / k : 0.0;
-  Candidate c = make_candidate(cx, "integrator", {{j, i}}, {std::move(f)}, 2);
+  Candidate c = make_candidate(cx, h, {{j, i}}, {std::move(f)});
   c.finding.nominal = g;
   c.finding.fitted = integrating(k);
   c.finding.parameters["integrator_gain_per_sample"] = k * g.dc_gain() * (replaces_pole ? 1.0 - p : 1.0);
   c.finding.parameters["balance_input_offset"] = balance;
-  c.finding.summary = arrow(cx, j, i) + " integrates: " +
-                      (replaces_pole ? "slowest pole " + fmt(p) + " -> 1" : std::string("an integrator after the channel")) +
-                      ", gain x " + fmt(k) + ", holding still at " + cx.problem.inputs[i] + " " + fmt(balance) +
-                      " from the model's operating point";
+  c.facts["gain_ratio"] = k;
+  if (replaces_pole) c.facts["replaced_pole"] = p;
   out.push_back(std::move(c));
 }
 
-// First order plus dead time from signal x to output j: K (1-a)/(1-a q^-1) q^-delay.
-struct Fopdt {
-  double pole = 0.0;
-  int delay = 0;
-};
-Fopdt best_fopdt(const Context& cx, std::size_t j, const Vec& x, int min_delay, int max_delay) {
+Fopdt best_fopdt(const Context& cx, std::size_t j, const Vec& x, int min_delay, int max_delay, bool refine_pole) {
   Fopdt best;
   double best_obj = std::numeric_limits<double>::infinity();
   std::vector<double> poles{0.0};
@@ -173,7 +161,7 @@ Fopdt best_fopdt(const Context& cx, std::size_t j, const Vec& x, int min_delay, 
       }
     }
   }
-  // refine the pole at the best delay
+  if (!refine_pole) return best;
   std::vector<double> fine;
   const double t0 = std::max(0.3, tau_of(best.pole));
   for (int k = -4; k <= 4; ++k) fine.push_back(std::exp(-1.0 / (t0 * std::pow(1.35, k))));
@@ -184,12 +172,13 @@ Fopdt best_fopdt(const Context& cx, std::size_t j, const Vec& x, int min_delay, 
   return best;
 }
 
-void missing_channel(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
+void fit_missing_channel(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t j = s.output, i = s.input;
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
-  const Fopdt f = best_fopdt(cx, j, u, cx.min_input_delay, 20);
+  const Fopdt f = best_fopdt(cx, j, u, cx.min_input_delay, 20, true);
   OutputFit fit = fit_output(cx, j, Vec(), {shifted(simulate(unit_lag(f.pole), u), f.delay)});
   const double k = fit.fit.theta(0);
-  Candidate c = make_candidate(cx, "missing_channel", {{j, i}}, {std::move(fit)}, 3);
+  Candidate c = make_candidate(cx, h, {{j, i}}, {std::move(fit)});
   DiscreteTf nominal;
   if (cx.channel(j, i)) nominal = *cx.channel(j, i);
   DiscreteTf fitted;
@@ -198,13 +187,10 @@ void missing_channel(const Context& cx, std::size_t j, std::size_t i, std::vecto
   fitted.delay = f.delay;
   c.finding.nominal = nominal;
   c.finding.fitted = fitted;
-  c.finding.summary = "the model has no " + arrow(cx, j, i) + " channel; the plant responds with gain " + fmt(k) +
-                      ", time constant " + fmt(tau_of(f.pole) * cx.problem.sample_time) + " s, delay " +
-                      std::to_string(f.delay) + " samples";
+  c.facts["gain"] = k;
+  c.facts["pole"] = f.pole;
   out.push_back(std::move(c));
 }
-
-}  // namespace
 
 std::vector<double> lag_pole_grid(double tau_lo, double tau_hi, int points) {
   std::vector<double> g;
@@ -221,33 +207,6 @@ std::string fmt(double v, int digits) {
   return b;
 }
 
-Candidate make_candidate(const Context& cx, std::string physics, std::vector<Channel> channels,
-                         std::vector<OutputFit> fits, int params) {
-  Candidate c;
-  c.finding.physics = std::move(physics);
-  c.finding.channels = std::move(channels);
-  c.fits = std::move(fits);
-  c.params = params;
-  c.finding.params = params;
-  score(cx, c);
-  c.finding.lr = c.lr;
-  if (!keeps_series(cx, c)) release_series(c);
-  return c;
-}
-
 double tau_of(double pole) { return pole > 0.0 && pole < 1.0 ? -1.0 / std::log(pole) : 0.0; }
-
-void channel_hypotheses(const Context& cx, std::size_t j, std::size_t i, std::vector<Candidate>& out) {
-  if (!cx.excited[i]) return;
-  if (!cx.has_channel(j, i)) {
-    missing_channel(cx, j, i, out);
-    return;
-  }
-  gain(cx, j, i, out);
-  dead_time(cx, j, i, out);
-  time_constant(cx, j, i, out);
-  extra_lag(cx, j, i, out);
-  integrator(cx, j, i, out);
-}
 
 }  // namespace mpm::diagnosis

@@ -1,15 +1,15 @@
 // Hypotheses that span several channels (one input's column: actuator lag,
 // saturation, backlash, operating-point gain; one output's row: sensor lag)
-// and recorded signals the model leaves out (unmodeled_input).
+// and recorded signals the model leaves out (unmodeled_input). Their rows are
+// in diagnosis_table.cpp, their sentences in diagnosis_summary.cpp.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "core/chi_square.hpp"
-#include "core/diagnosis_context.hpp"
+#include "core/diagnosis_table.hpp"
 
 namespace mpm::diagnosis {
-namespace {
 
 std::vector<std::size_t> column_outputs(const Context& cx, std::size_t i) {
   std::vector<std::size_t> js;
@@ -17,6 +17,20 @@ std::vector<std::size_t> column_outputs(const Context& cx, std::size_t i) {
     if (cx.has_channel(j, i)) js.push_back(j);
   return js;
 }
+
+// The model's prediction of output j, sum_i G_ji du_i over the excited
+// inputs with a channel, and those channels.
+RowPrediction row_prediction(const Context& cx, std::size_t j) {
+  RowPrediction r{{}, Vec::Zero(cx.problem.du.rows())};
+  for (std::size_t i = 0; i < cx.n_in(); ++i)
+    if (cx.has_channel(j, i) && cx.excited[i]) {
+      r.channels.push_back({j, i});
+      r.total += cx.gu[j * cx.n_in() + i];
+    }
+  return r;
+}
+
+namespace {
 
 std::vector<Channel> column_channels(const std::vector<std::size_t>& js, std::size_t i) {
   std::vector<Channel> cs;
@@ -33,22 +47,25 @@ std::vector<OutputFit> input_change_fits(const Context& cx, std::size_t i, const
   return fits;
 }
 
+}  // namespace
 
-void actuator(const Context& cx, std::size_t i, const std::vector<std::size_t>& js, std::vector<Candidate>& out) {
+void fit_actuator(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t i = s.input;
+  const auto js = column_outputs(cx, i);
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
   auto fits = [&](double a) { return input_change_fits(cx, i, js, simulate(unit_lag(a), u)); };
   const double a = minimise_on_grid(lag_pole_grid(0.3, 30.0, 16), [&](double v) { return objective(cx, fits(v)); });
-  Candidate c = make_candidate(cx, "actuator_dynamics", column_channels(js, i), fits(a), 1);
+  Candidate c = make_candidate(cx, h, column_channels(js, i), fits(a));
   c.finding.nominal = *cx.channel(js[0], i);
   c.finding.fitted = series(*cx.channel(js[0], i), unit_lag(a));
   c.finding.parameters["actuator_lag_pole"] = a;
   c.finding.parameters["actuator_time_constant"] = tau_of(a) * cx.problem.sample_time;
-  c.finding.summary = "actuator of " + cx.problem.inputs[i] + " lags with time constant " +
-                      fmt(tau_of(a) * cx.problem.sample_time) + " s (pole " + fmt(a) + ") on every channel";
   out.push_back(std::move(c));
 }
 
-void saturation(const Context& cx, std::size_t i, const std::vector<std::size_t>& js, std::vector<Candidate>& out) {
+void fit_saturation(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t i = s.input;
+  const auto js = column_outputs(cx, i);
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
   std::vector<double> sorted;
   for (Index k = 0; k < u.size(); ++k)
@@ -74,17 +91,17 @@ void saturation(const Context& cx, std::size_t i, const std::vector<std::size_t>
     }
   }
   const Vec v = upper ? clipped(u, -1e300, best_limit) : clipped(u, best_limit, 1e300);
-  Candidate c = make_candidate(cx, "saturation", column_channels(js, i), input_change_fits(cx, i, js, v), 1);
+  Candidate c = make_candidate(cx, h, column_channels(js, i), input_change_fits(cx, i, js, v));
   const double u0 = cx.problem.u_abs(0, static_cast<Index>(i)) - cx.problem.du(0, static_cast<Index>(i));
   c.finding.nominal = *cx.channel(js[0], i);
   c.finding.fitted = *cx.channel(js[0], i);
   c.finding.parameters[upper ? "upper_limit" : "lower_limit"] = u0 + best_limit;
-  c.finding.summary = cx.problem.inputs[i] + " stops acting " + (upper ? "above " : "below ") + fmt(u0 + best_limit, 4) +
-                      " (the model knows no limit there)";
   out.push_back(std::move(c));
 }
 
-void deadband(const Context& cx, std::size_t i, const std::vector<std::size_t>& js, std::vector<Candidate>& out) {
+void fit_deadband(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t i = s.input;
+  const auto js = column_outputs(cx, i);
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
   const Vec moves = (u.tail(u.size() - 1) - u.head(u.size() - 1)).cwiseAbs();
   const double scale = std::max(1e-12, moves.mean());
@@ -92,14 +109,14 @@ void deadband(const Context& cx, std::size_t i, const std::vector<std::size_t>& 
   for (int k = 0; k <= 14; ++k) grid.push_back(std::log(0.05 * scale) + k * std::log(200.0) / 14.0);
   auto fits = [&](double lw) { return input_change_fits(cx, i, js, backlash(u, std::exp(lw))); };
   const double lw = minimise_on_grid(grid, [&](double v) { return objective(cx, fits(v)); });
-  Candidate c = make_candidate(cx, "deadband", column_channels(js, i), fits(lw), 1);
+  Candidate c = make_candidate(cx, h, column_channels(js, i), fits(lw));
   c.finding.nominal = *cx.channel(js[0], i);
   c.finding.fitted = *cx.channel(js[0], i);
   c.finding.parameters["backlash_width"] = std::exp(lw);
-  c.finding.summary = cx.problem.inputs[i] + " has a backlash (deadband) of total width " + fmt(std::exp(lw)) +
-                      ": reversals smaller than that do nothing";
   out.push_back(std::move(c));
 }
+
+namespace {
 
 // Mean of x over the fit part.
 double fit_mean(const Context& cx, const Vec& x) {
@@ -126,8 +143,8 @@ double fit_mean(const Context& cx, const Vec& x) {
 // likelihood ratio, 2 degrees of freedom per channel, at the family-wise
 // level, Bonferroni over the maps tried): a plain gain change is left to the
 // gain hypotheses.
-void static_nonlinearity(const Context& cx, std::size_t i, const std::vector<std::size_t>& js,
-                         std::vector<Candidate>& out) {
+void static_map(const Context& cx, const Hypothesis& h, std::size_t i, const std::vector<std::size_t>& js,
+                std::vector<Candidate>& out) {
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
   const Vec v = (u.array() - fit_mean(cx, u)).matrix();
   Vec even = v.cwiseProduct(v);
@@ -162,40 +179,19 @@ void static_nonlinearity(const Context& cx, std::size_t i, const std::vector<std
   }
   if (nested < chi_square_quantile_upper(cx.settings.alpha / std::max(1.0, tests), 2.0 * n_ch)) return;
   std::vector<Channel> cs = column_channels(js, i);
-  Candidate c = make_candidate(cx, "nonlinear_gain", cs, fits, 3 * n_ch);
+  Candidate c = make_candidate(cx, h, cs, fits);
   c.finding.nominal = *cx.channel(js[0], i);
   c.finding.fitted = *cx.channel(js[0], i);
   c.finding.parameters["nonlinear_lr"] = nested;
-  std::string terms;
   for (std::size_t r = 0; r < js.size(); ++r) {
     const LinearFit& f = c.fits[r].fit;
     const std::string suffix = js.size() == 1 ? std::string() : "_" + cx.problem.outputs[js[r]];
     c.finding.parameters["gain_factor" + suffix] = 1.0 + f.theta(0);
     c.finding.parameters["even_coefficient" + suffix] = f.theta(1);
     c.finding.parameters["odd_coefficient" + suffix] = f.theta(2);
-    terms += (r ? "; " : "") + cx.problem.outputs[js[r]] + ": gain x " + fmt(1.0 + f.theta(0)) + ", even " +
-             fmt(f.theta(1)) + ", odd " + fmt(f.theta(2));
   }
-  c.finding.summary = "gain of " + cx.problem.inputs[i] + " changes with its level around " +
-                      fmt(cx.problem.u_abs(0, static_cast<Index>(i)) - u(0) + fit_mean(cx, u), 4) + " (" + terms +
-                      " per unit^2 of " + cx.problem.inputs[i] + ")";
+  c.facts["working_level"] = cx.problem.u_abs(0, static_cast<Index>(i)) - u(0) + fit_mean(cx, u);
   out.push_back(std::move(c));
-}
-
-// The model's prediction of output j, sum_i G_ji du_i over the excited
-// inputs with a channel, and those channels.
-struct RowPrediction {
-  std::vector<Channel> channels;
-  Vec total;
-};
-RowPrediction row_prediction(const Context& cx, std::size_t j) {
-  RowPrediction r{{}, Vec::Zero(cx.problem.du.rows())};
-  for (std::size_t i = 0; i < cx.n_in(); ++i)
-    if (cx.has_channel(j, i) && cx.excited[i]) {
-      r.channels.push_back({j, i});
-      r.total += cx.gu[j * cx.n_in() + i];
-    }
-  return r;
 }
 
 // Gain varying with the output's own level: y = G u (1 + b G u), the
@@ -206,7 +202,8 @@ RowPrediction row_prediction(const Context& cx, std::size_t j) {
 // which per-input u^2 terms cannot say when the inputs move together in
 // closed loop. Over several outputs it is one candidate, so that it is
 // weighed as one explanation against the per-input ones.
-void level_gain(const Context& cx, const std::vector<std::size_t>& js, std::vector<Candidate>& out) {
+void level_gain(const Context& cx, const Hypothesis& h, const std::vector<std::size_t>& js,
+                std::vector<Candidate>& out) {
   std::vector<OutputFit> fits;
   std::vector<Channel> cs;
   for (std::size_t j : js) {
@@ -215,42 +212,32 @@ void level_gain(const Context& cx, const std::vector<std::size_t>& js, std::vect
     cs.insert(cs.end(), row.channels.begin(), row.channels.end());
   }
   const auto first = static_cast<std::size_t>(cs[0].input.value());
-  Candidate c = make_candidate(cx, "nonlinear_gain", cs, fits, static_cast<int>(js.size()));
+  Candidate c = make_candidate(cx, h, cs, fits);
   c.finding.nominal = *cx.channel(js[0], first);
   c.finding.fitted = *cx.channel(js[0], first);
-  std::string slopes;
-  for (std::size_t r = 0; r < js.size(); ++r) {
-    const std::string& name = cx.problem.outputs[js[r]];
-    const double b = fits[r].fit.theta(0);
-    c.finding.parameters["gain_slope_per_unit_" + name] = b;
-    slopes += (r ? ", " : "") + fmt(b) + " per unit of " + name;
-  }
-  c.finding.summary = "gain of every input into " +
-                      (js.size() == 1 ? cx.problem.outputs[js[0]] : std::string("each output")) +
-                      " changes with that output's level (relative slope " + slopes + ")";
+  for (std::size_t r = 0; r < js.size(); ++r)
+    c.finding.parameters["gain_slope_per_unit_" + cx.problem.outputs[js[r]]] = fits[r].fit.theta(0);
   out.push_back(std::move(c));
 }
 
 }  // namespace
 
-void column_hypotheses(const Context& cx, std::size_t i, std::vector<Candidate>& out) {
-  if (!cx.excited[i]) return;
-  const auto js = column_outputs(cx, i);
-  if (js.empty()) return;
-  if (js.size() >= 2) actuator(cx, i, js, out);
-  saturation(cx, i, js, out);
-  deadband(cx, i, js, out);
-  static_nonlinearity(cx, i, js, out);
+void fit_static_map(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const auto js = column_outputs(cx, s.input);
+  static_map(cx, h, s.input, js, out);
   if (js.size() >= 2)
-    for (std::size_t j : js) static_nonlinearity(cx, i, {j}, out);
+    for (std::size_t j : js) static_map(cx, h, s.input, {j}, out);
 }
 
-void row_hypotheses(const Context& cx, std::size_t j, std::vector<Candidate>& out) {
+void fit_row_level_gain(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  level_gain(cx, h, {s.output}, out);
+}
+
+void fit_sensor(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t j = s.output;
   const RowPrediction row = row_prediction(cx, j);
   const std::vector<Channel>& cs = row.channels;
   const Vec& total = row.total;
-  if (cs.size() < 2) return;
-  level_gain(cx, {j}, out);
   // A transmitter lag S = (1 - a) / (1 - a q^-1) filters everything the
   // sensor sees, the model-predicted part and the disturbances alike: the
   // measured output is x = S x_true, with x = r + G_M u (r the residual, the
@@ -284,64 +271,51 @@ void row_hypotheses(const Context& cx, std::size_t j, std::vector<Candidate>& ou
   const double lr_sensor = -objective(cx, fits(a));
   const double lr_noise = -objective(cx, noise_only(a_noise));
   if (lr_sensor - lr_noise < chi_square_quantile_upper(cx.settings.alpha, 1.0)) return;
-  Candidate c = make_candidate(cx, "sensor_dynamics", cs, fits(a), 1);
+  Candidate c = make_candidate(cx, h, cs, fits(a));
   c.finding.nominal = *cx.channel(j, cs[0].input.value());
   c.finding.fitted = series(*cx.channel(j, cs[0].input.value()), unit_lag(a));
   c.finding.parameters["sensor_lag_pole"] = a;
   c.finding.parameters["sensor_time_constant"] = tau_of(a) * cx.problem.sample_time;
-  c.finding.summary = "sensor of " + cx.problem.outputs[j] + " lags with time constant " +
-                      fmt(tau_of(a) * cx.problem.sample_time) + " s (pole " + fmt(a) + ")";
   out.push_back(std::move(c));
 }
 
-void signal_hypotheses(const Context& cx, std::size_t j, std::size_t column, std::vector<Candidate>& out) {
-  const Vec z = cx.extra.col(static_cast<Index>(column));
-  const std::string& name = cx.problem.extra_names[column];
-  // (a) first order plus dead time; (b) the signal acts through an input's
-  // nominal channel (a disturbance entering where that input enters).
+void fit_signal_through_channel(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t j = s.output;
+  const Vec z = cx.extra.col(static_cast<Index>(s.column));
   for (std::size_t i = 0; i < cx.n_in(); ++i) {
     if (!cx.has_channel(j, i)) continue;
     std::vector<OutputFit> f{fit_output(cx, j, Vec(), {simulate(*cx.channel(j, i), z)})};
     DiscreteTf tf = *cx.channel(j, i);
-    for (double& b : tf.num) b *= f[0].fit.theta(0);
-    const std::string how = "acts like " + cx.problem.inputs[i] + " (through its channel, x " + fmt(f[0].fit.theta(0)) + ")";
-    Candidate c = make_candidate(cx, "unmodeled_input", {{j, std::nullopt}}, std::move(f), 1);
-    c.finding.signal = name;
+    const double k = f[0].fit.theta(0);
+    for (double& b : tf.num) b *= k;
+    Candidate c = make_candidate(cx, h, {{j, std::nullopt}}, std::move(f));
+    c.finding.signal = cx.problem.extra_names[s.column];
     c.finding.fitted = tf;
-    c.finding.summary = "recorded signal " + name + " drives " + cx.problem.outputs[j] + ": it " + how;
+    c.facts["through_input"] = static_cast<double>(i);
+    c.facts["factor"] = k;
     out.push_back(std::move(c));
   }
-  const auto fo = [&] {
-    struct R { double pole; int delay; };
-    double bo = std::numeric_limits<double>::infinity();
-    R r{0.0, 0};
-    std::vector<double> poles{0.0};
-    for (double a : lag_pole_grid(0.5, 200.0, 14)) poles.push_back(a);
-    for (double a : poles) {
-      const Vec lagged = simulate(unit_lag(a), z);
-      for (int d = 0; d <= cx.settings.max_extra_delay; ++d) {
-        const double o = objective(cx, {fit_output(cx, j, Vec(), {shifted(lagged, d)})});
-        if (o < bo) { bo = o; r = {a, d}; }
-      }
-    }
-    return r;
-  }();
+}
+
+void fit_signal_fopdt(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t j = s.output;
+  const Vec z = cx.extra.col(static_cast<Index>(s.column));
+  const Fopdt fo = best_fopdt(cx, j, z, 0, cx.settings.max_extra_delay, false);
   std::vector<OutputFit> f{fit_output(cx, j, Vec(), {shifted(simulate(unit_lag(fo.pole), z), fo.delay)})};
   const double k = f[0].fit.theta(0);
   DiscreteTf tf;
   tf.num = {k * (1.0 - fo.pole)};
   tf.den = {1.0, -fo.pole};
   tf.delay = fo.delay;
-  Candidate c = make_candidate(cx, "unmodeled_input", {{j, std::nullopt}}, std::move(f), 3);
-  c.finding.signal = name;
+  Candidate c = make_candidate(cx, h, {{j, std::nullopt}}, std::move(f));
+  c.finding.signal = cx.problem.extra_names[s.column];
   c.finding.fitted = tf;
-  c.finding.summary = "recorded signal " + name + " drives " + cx.problem.outputs[j] + " through gain " + fmt(k) +
-                      ", time constant " + fmt(tau_of(fo.pole) * cx.problem.sample_time) + " s, delay " +
-                      std::to_string(fo.delay) + " samples";
+  c.facts["gain"] = k;
+  c.facts["pole"] = fo.pole;
   out.push_back(std::move(c));
 }
 
-void plant_hypotheses(const Context& cx, std::vector<Candidate>& out) {
+void fit_plant_level_gain(const Context& cx, const Hypothesis& h, const Site&, std::vector<Candidate>& out) {
   std::vector<std::size_t> js;
   // Only outputs that several inputs drive: with one input, a gain set by
   // the output's level is that channel's own static map, which the channel
@@ -350,7 +324,7 @@ void plant_hypotheses(const Context& cx, std::vector<Candidate>& out) {
   // nonlinearity.
   for (std::size_t j = 0; j < cx.n_out(); ++j)
     if (row_prediction(cx, j).channels.size() >= 2) js.push_back(j);
-  if (js.size() >= 2) level_gain(cx, js, out);
+  level_gain(cx, h, js, out);
 }
 
 }  // namespace mpm::diagnosis

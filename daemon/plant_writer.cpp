@@ -87,9 +87,15 @@ double param(const diagnosis::Finding& f, const char* key, double fallback) {
   return it == f.parameters.end() ? fallback : it->second;
 }
 
-bool is_channel_physics(const std::string& p) {
-  return p == "gain" || p == "dead_time" || p == "time_constant" || p == "unmodeled_dynamics" || p == "integrator" ||
-         p == "missing_channel";
+using diagnosis::Physics;
+bool is(const diagnosis::Finding& f, Physics p) { return f.physics == diagnosis::word(p); }
+
+// Findings on one channel whose fitted model replaces (or changes) that channel.
+bool is_channel_physics(const diagnosis::Finding& f) {
+  for (Physics p : {Physics::gain, Physics::dead_time, Physics::time_constant, Physics::unmodeled_dynamics,
+                    Physics::integrator, Physics::missing_channel})
+    if (is(f, p)) return true;
+  return false;
 }
 
 // Index into plant.channels of (output, input), added (zero) when absent.
@@ -109,16 +115,16 @@ void apply_channel(CorrectedPlant& c, const diagnosis::Finding& f, const diagnos
   ChannelModel& m = c.plant.channels[k];
   const bool first = c.why[k].empty();
   if (first) c.why[k].push_back(was(m));
-  if (f.physics == "gain") {
+  if (is(f, Physics::gain)) {
     const double g = param(f, "gain_factor", 1.0);
     for (double& b : m.tf.num) b *= g;
     if (m.continuous)
       for (double& b : m.continuous->num) b *= g;
-  } else if (f.physics == "dead_time") {
+  } else if (is(f, Physics::dead_time)) {
     const int s = static_cast<int>(std::lround(param(f, "extra_delay_samples", 0.0)));
     m.tf.delay += s;
     if (m.continuous) m.continuous->dead_time += s * c.plant.sample_time;
-  } else if (f.physics == "unmodeled_dynamics" && f.parameters.count("extra_lag_pole")) {
+  } else if (is(f, Physics::unmodeled_dynamics) && f.parameters.count("extra_lag_pole")) {
     m.tf = diagnosis::series(m.tf, diagnosis::unit_lag(param(f, "extra_lag_pole", 0.0)));
     m.continuous.reset();
   } else {
@@ -152,13 +158,13 @@ CorrectedPlant apply_findings(const PlantModel& plant, const diagnosis::Result& 
   c.noise_why.assign(plant.n_outputs(), {});
   for (const diagnosis::Finding& f : result.findings) {
     const bool one_channel = f.channels.size() == 1 && f.channels[0].input.has_value();
-    if (is_channel_physics(f.physics) && one_channel && f.fitted) {
+    if (is_channel_physics(f) && one_channel && f.fitted) {
       apply_channel(c, f, f.channels[0]);
-    } else if (f.physics == "actuator_dynamics" && f.parameters.count("actuator_lag_pole")) {
+    } else if (is(f, Physics::actuator_dynamics) && f.parameters.count("actuator_lag_pole")) {
       apply_series_lag(c, f, f.parameters.at("actuator_lag_pole"));
-    } else if (f.physics == "sensor_dynamics" && f.parameters.count("sensor_lag_pole")) {
+    } else if (is(f, Physics::sensor_dynamics) && f.parameters.count("sensor_lag_pole")) {
       apply_series_lag(c, f, f.parameters.at("sensor_lag_pole"));
-    } else if (f.physics == "disturbance_model" && f.fitted && f.channels.size() == 1) {
+    } else if (is(f, Physics::disturbance_model) && f.fitted && f.channels.size() == 1) {
       const std::size_t j = f.channels[0].output;
       NoiseModel n;
       n.tf = *f.fitted;

@@ -1,0 +1,65 @@
+// The disturbance-model hypothesis: where no finding explains an output whose
+// noise model N the plant file gives, a changed N. Tried after the search
+// (diagnose()), at its own family-wise level over the forms and outputs.
+#include <cmath>
+#include <optional>
+
+#include "core/chi_square.hpp"
+#include "core/diagnosis_table.hpp"
+
+namespace mpm::diagnosis {
+
+void fit_disturbance_model(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t j = s.output;
+  const Index n_fit = cx.seg.fit_samples();
+  const OutputState& o = cx.out[j];
+  // Corrections C = num / den of the whitened residual N^-1 d (the new
+  // disturbance model is N / C): AR(1..3), and ARMA(1,1). A first-order N
+  // whose pole moved leaves N^-1 d = (1 - p q^-1) / (1 - p' q^-1) a, a pole
+  // and zero that nearly cancel: low-order AR fits take it up poorly, the
+  // ARMA(1,1) exactly (den pole on a grid, num by least squares).
+  std::vector<DiscreteTf> corrections;
+  for (int k = 1; k <= 3; ++k) corrections.push_back(DiscreteTf{fit_ar(o.wd, cx.seg.fit, k), {1.0}, 0});
+  const auto arma = [&](double b) {
+    const Vec v = simulate(DiscreteTf{{1.0}, {1.0, -b}, 0}, o.wd);
+    return DiscreteTf{fit_ar(v, cx.seg.fit, 1), {1.0, -b}, 0};
+  };
+  std::vector<double> poles;
+  for (int k = -6; k <= 14; ++k) poles.push_back(k < 0 ? 0.15 * k : 1.0 - std::pow(0.7, k + 1));
+  const double b = minimise_on_grid(poles, [&](double v) {
+    return least_squares(simulate(arma(v), o.wd), {}, cx.seg).fit_var;
+  });
+  corrections.push_back(arma(b));
+  const double limit_alpha = fit_level(cx.settings, static_cast<double>(corrections.size() * cx.n_out()));
+  std::optional<Candidate> best;
+  DiscreteTf best_correction;
+  for (const DiscreteTf& correction : corrections) {
+    const int params = static_cast<int>(correction.den.size() > 1 ? 2 : correction.num.size() - 1);
+    OutputFit of;
+    of.output = j;
+    of.correction = Vec::Zero(o.d.size());
+    of.fit = least_squares(simulate(correction, o.wd), {}, cx.seg);
+    std::vector<OutputFit> fits;
+    fits.push_back(std::move(of));
+    Candidate c = make_candidate(cx, h, {{j, std::nullopt}}, std::move(fits), params);
+    if (c.lr < chi_square_quantile_upper(limit_alpha, params) || c.z_hold < cx.settings.holdout_z || c.hold_gain <= 0.0)
+      continue;
+    if (!best || c.bic(std::log(static_cast<double>(n_fit))) > best->bic(std::log(static_cast<double>(n_fit)))) {
+      best = std::move(c);
+      best_correction = correction;
+    }
+  }
+  if (!best) return;
+  const DiscreteTf& nn = *cx.problem.noise[j];
+  best->finding.nominal = nn;
+  DiscreteTf fitted = nn;
+  fitted.num = poly_mul(nn.num, best_correction.den);
+  fitted.den = poly_mul(nn.den, best_correction.num);
+  best->finding.fitted = fitted;
+  best->finding.parameters["variance"] = best->fits[0].fit.fit_var;
+  best->facts["variance_before"] = o.fit_var;
+  best->facts["arma"] = best_correction.den.size() > 1 ? 1.0 : 0.0;
+  out.push_back(std::move(*best));
+}
+
+}  // namespace mpm::diagnosis

@@ -1,0 +1,223 @@
+// Scoring of the diagnosis' candidates: the joint fit of one output under a
+// hypothesis (with the output's accepted recorded signals free), the
+// likelihood ratio on the fit part, the held-out confirmation, the test
+// beyond a changed disturbance model, and the tests and score the selection
+// applies to them.
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/chi_square.hpp"
+#include "core/diagnosis_table.hpp"
+
+namespace mpm::diagnosis {
+
+double Candidate::bic(double log_n) const { return lr - params * log_n; }
+
+OutputFit fit_output(const Context& cx, std::size_t j, Vec c0, std::vector<Vec> X) {
+  const OutputState& o = cx.out[j];
+  OutputFit f;
+  f.output = j;
+  const bool joint = !o.signals.empty();
+  const Vec& w0 = joint ? o.wbase : o.wd;
+  // The whitened columns are the only N-long temporaries; the output's own
+  // (w0, its whitened signals) are read in place.
+  Vec wc0;
+  if (c0.size()) {
+    wc0 = simulate(o.whitener, c0);
+    wc0 = w0 - wc0;  // coefficient-wise, in place
+  }
+  std::vector<Vec> wx;
+  wx.reserve(X.size());
+  for (const Vec& x : X) wx.push_back(simulate(o.whitener, x));
+  std::vector<const Vec*> regs;
+  regs.reserve(X.size() + o.wsignals.size());
+  for (const Vec& x : wx) regs.push_back(&x);
+  if (joint)
+    for (const Vec& s : o.wsignals) regs.push_back(&s);
+  f.fit = least_squares_at(c0.size() ? wc0 : w0, regs, cx.seg);
+  wc0.resize(0);
+  wx.clear();
+  f.correction = c0.size() ? c0 : Vec::Zero(o.d.size());
+  for (std::size_t l = 0; l < X.size(); ++l) f.correction += f.fit.theta(static_cast<Index>(l)) * X[l];
+  f.fixed = std::move(c0);
+  f.regressors = std::move(X);
+  if (joint) {
+    const auto nx = static_cast<Index>(f.regressors.size()), ns = static_cast<Index>(o.signals.size());
+    f.signal_theta = f.fit.theta.segment(nx, ns);
+    for (Index s = 0; s < ns; ++s)
+      f.correction += (f.signal_theta(s) - o.signal_theta(s)) * o.signals[static_cast<std::size_t>(s)];
+    f.fit.theta.conservativeResize(nx);
+    f.fit.theta_se.conservativeResize(nx);
+  }
+  return f;
+}
+
+void release_series(Candidate& c) {
+  for (OutputFit& f : c.fits) {
+    f.correction.resize(0);
+    f.fixed.resize(0);
+    f.regressors.clear();
+    f.regressors.shrink_to_fit();
+    f.fit.hold_error.resize(0);
+  }
+}
+
+bool keeps_series(const Context& cx, const Candidate& c) {
+  if (cx.keep_series) return true;
+  const Candidate* r = cx.rebuilding;
+  return r && r->lr == c.lr && r->hypothesis == c.hypothesis && r->params == c.params && r->z_hold == c.z_hold;
+}
+
+std::vector<Vec> noise_change_regressors(const Vec& r) { return {shifted(r, 1), shifted(r, 2), shifted(r, 3)}; }
+
+double objective(const Context& cx, const std::vector<OutputFit>& fits) {
+  double s = 0.0;
+  for (const auto& f : fits) s += std::log(f.fit.fit_var / cx.out[f.output].fit_var);
+  return s * static_cast<double>(cx.seg.fit_samples());
+}
+
+double objective(const Context& cx, const OutputFit& fit) {
+  double s = 0.0;
+  s += std::log(fit.fit.fit_var / cx.out[fit.output].fit_var);
+  return s * static_cast<double>(cx.seg.fit_samples());
+}
+
+Candidate make_candidate(const Context& cx, const Hypothesis& h, std::vector<Channel> channels,
+                         std::vector<OutputFit> fits, int params) {
+  Candidate c;
+  c.hypothesis = &h;
+  c.finding.physics = word(h.physics);
+  c.finding.channels = std::move(channels);
+  c.fits = std::move(fits);
+  c.params = params;
+  c.finding.params = params;
+  score(cx, c);
+  c.finding.lr = c.lr;
+  if (!keeps_series(cx, c)) release_series(c);
+  return c;
+}
+
+Candidate make_candidate(const Context& cx, const Hypothesis& h, std::vector<Channel> channels,
+                         std::vector<OutputFit> fits) {
+  const int params = h.count(channels.size(), fits.size());
+  return make_candidate(cx, h, std::move(channels), std::move(fits), params);
+}
+
+Candidate make_candidate(const Context& cx, const Hypothesis& h, std::vector<Channel> channels, OutputFit fit) {
+  std::vector<OutputFit> fits;
+  fits.push_back(std::move(fit));
+  return make_candidate(cx, h, std::move(channels), std::move(fits));
+}
+
+void score(const Context& cx, Candidate& c) {
+  c.lr = -objective(cx, c.fits);
+  // Out of sample: does the (whitened) correction point along the held-out
+  // residual? z = <e0, w c> / (sigma0 |w c|), N(0, 1) when c is unrelated to
+  // it; and the held-out variance must drop.
+  // The variance of <e0, w c> is taken with the autocovariance of the errors
+  // the candidate leaves (Bartlett window): they are white when the noise
+  // model is right and the candidate explains the mismatch, and then this is
+  // sigma0^2 |w c|^2; when the disturbances are coloured beyond what the
+  // whitener knows, a slowly varying correction lines up with them by chance
+  // far more often, and the test must not take that for evidence.
+  constexpr Index kLags = 20;
+  const Index nh = cx.out.empty() ? 0 : cx.out[0].d.size();
+  // The held-out part as runs of consecutive samples (lags stay inside one).
+  std::vector<std::pair<Index, Index>> runs;
+  for (Index k = 0; k < nh; ++k) {
+    if (!cx.seg.hold[static_cast<std::size_t>(k)]) continue;
+    if (runs.empty() || runs.back().second != k) runs.push_back({k, k});
+    runs.back().second = k + 1;
+  }
+  double num = 0.0, var = 0.0;
+  c.hold_gain = 0.0;
+  std::array<double, kLags + 1> gamma{}, cross{};
+  std::array<Index, kLags + 1> pairs{};
+  for (const auto& f : c.fits) {
+    const OutputState& o = cx.out[f.output];
+    const Vec& e1 = f.fit.hold_error;
+    const Vec wc = o.hold_error - e1;
+    gamma.fill(0.0);
+    cross.fill(0.0);
+    pairs.fill(0);
+    for (const auto& [first, end] : runs)
+      for (Index k = first; k < end; ++k) {
+        num += o.hold_error(k) * wc(k);
+        const Index last = std::min(kLags, end - 1 - k);
+        for (Index l = 0; l <= last; ++l) {
+          gamma[static_cast<std::size_t>(l)] += e1(k) * e1(k + l);
+          cross[static_cast<std::size_t>(l)] += wc(k) * wc(k + l);
+          ++pairs[static_cast<std::size_t>(l)];
+        }
+      }
+    for (std::size_t l = 0; l <= static_cast<std::size_t>(kLags); ++l) {
+      if (pairs[l] == 0) break;
+      const double weight = l == 0 ? 1.0 : 2.0 * (1.0 - static_cast<double>(l) / static_cast<double>(kLags + 1));
+      var += weight * gamma[l] / static_cast<double>(pairs[l]) * cross[l];
+    }
+    c.hold_gain += std::log(o.hold_var / f.fit.hold_var);
+  }
+  c.z_hold = var > 0.0 ? num / std::sqrt(var) : 0.0;
+
+  // Under feedback G_M u mirrors the disturbances the controller rejects, so
+  // a correction built from it can take up a disturbance model that the
+  // whitener has wrong. Refitted jointly with an AR(3) change of that model
+  // (the lags of the residual the correction leaves, so that they cannot
+  // take up the correction itself), a real process change still explains
+  // the residual; one that rode on the wrong N does not.
+  double beyond = 0.0;
+  for (const auto& f : c.fits) {
+    const OutputState& o = cx.out[f.output];
+    std::vector<Vec> X = f.regressors;
+    for (Vec& lag : noise_change_regressors(o.d - f.correction)) X.push_back(std::move(lag));
+    beyond += std::log(o.noise_change_var / fit_output(cx, f.output, f.fixed, X).fit.fit_var);
+  }
+  c.lr_beyond_noise = beyond * static_cast<double>(cx.seg.fit_samples());
+}
+
+// The fit-part test and the held-out test are independent under "no
+// mismatch", so a candidate passes both with probability (fit level) x
+// (held-out level): the fit level is alpha / hold level, shared over the family.
+double fit_level(const Settings& s, double family) { return s.alpha / s.holdout_level / family; }
+
+// The row's gate: a recorded signal is not moved by the controller, so it is
+// not held to the test against a changed disturbance model (see score()).
+bool passes(const Candidate& c, const Settings& s, double family) {
+  return c.lr >= chi_square_quantile_upper(fit_level(s, family), c.params) && c.z_hold >= s.holdout_z &&
+         c.hold_gain > 0.0 &&
+         (c.hypothesis->gate != Gate::beyond_noise || c.lr_beyond_noise >= chi_square_quantile_upper(s.alpha, c.params));
+}
+
+// Which of the candidates that pass is taken: BIC on the fit part plus the
+// log-likelihood gain on the held-out part, which the fit never saw (so it
+// needs no penalty). Two hypotheses that fit the fit part alike (a slower
+// channel and a smaller gain look alike where the inputs move slowly) are
+// told apart by the data that judged neither.
+double selection_score(const Context& cx, const Candidate& c, double log_n) {
+  return c.bic(log_n) + static_cast<double>(cx.seg.hold_samples()) * c.hold_gain;
+}
+
+// The fit block: one-step prediction-error variances (the whitened residual
+// the fit minimises), summed over the finding's outputs. The raw residual's
+// variance is no measure of fit in closed loop (feedback correlates dG u
+// with the disturbance, so a correct correction can raise it); it is kept
+// in `raw` for the record.
+FitNumbers fit_numbers(const Context& cx, const Candidate& c, FitNumbers& raw) {
+  FitNumbers f;
+  for (const auto& of : c.fits) {
+    const OutputState& o = cx.out[of.output];
+    f.residual_variance_before += o.fit_var;
+    f.residual_variance_after += of.fit.fit_var;
+    f.holdout_variance_before += o.hold_var;
+    f.holdout_variance_after += of.fit.hold_var;
+    const Vec after = o.d - of.correction;
+    raw.residual_variance_before += variance(o.d, cx.seg.fit);
+    raw.residual_variance_after += variance(after, cx.seg.fit);
+    raw.holdout_variance_before += variance(o.d, cx.seg.hold);
+    raw.holdout_variance_after += variance(after, cx.seg.hold);
+  }
+  return f;
+}
+
+}  // namespace mpm::diagnosis
