@@ -293,6 +293,7 @@ void GrangerMonitor::react(std::size_t j, std::size_t k, double t, bool focused)
 }
 
 void GrangerMonitor::locate(std::size_t j, std::size_t window, double scale) noexcept {
+  refresh_statistics(j);  // gamma and the pairwise F, for the paper's rule
   // The conditional score of block i given the others: with P = S^-1 and
   // v = P s, s^T S^-1 s - s_-i^T S_-i^-1 s_-i = v_i^T [P]_ii^-1 v_i (Schur).
   // O((m nb)^3), on a raise only; everything preallocated.

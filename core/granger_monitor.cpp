@@ -64,6 +64,7 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   }
   channels_.assign(n_outputs * n_inputs, ChannelStats{});
   loops_.assign(n_outputs, LoopStats{});
+  stale_.assign(n_outputs, 0);
   divergence_ = DivergenceWatch(n_outputs, reference_variance, settings.forgetting);
   screen_ = OutlierScreen(n_outputs, settings.outlier_limit);
   recovered_.assign(n_outputs, 0);
@@ -85,6 +86,7 @@ void GrangerMonitor::reset() noexcept {
   sum_w_ = sum_w2_ = n_eq_ = 0.0;
   std::fill(channels_.begin(), channels_.end(), ChannelStats{});
   std::fill(loops_.begin(), loops_.end(), LoopStats{});
+  std::fill(stale_.begin(), stale_.end(), 0);
   divergence_.reset();
   for (auto& c : channels_) c.gamma = NAN;
   used_since_reset_ = 0;
@@ -105,6 +107,7 @@ void GrangerMonitor::reset_output(std::size_t j) noexcept {
   reset_alarms(j);
   divergence_.reset_output(j);
   loops_[j] = LoopStats{};
+  stale_[j] = 0;
   for (std::size_t i = 0; i < n_inputs_; ++i) {
     channels_[j * n_inputs_ + i] = ChannelStats{};
     channels_[j * n_inputs_ + i].gamma = NAN;
@@ -181,55 +184,62 @@ void GrangerMonitor::update_divergence(const double* residual) noexcept {
 }
 
 void GrangerMonitor::update_statistics() noexcept {
-  const std::size_t p_full = n_regressors();
-  const std::size_t p_pair = 1 + na_ + nb_;
-  const double scale_full = std::max(n_eq_ - static_cast<double>(p_full), 1.0);
-  const double scale_pair = std::max(n_eq_ - static_cast<double>(p_pair), 1.0);
   for (std::size_t j = first_output_; j < end_output_; ++j) {
-    const NestedRls& reg = regressions_[j];
-    LoopStats& loop = loops_[j];
-    const double rss_full = reg.rss_full();
-    const double rss_ar = reg.rss_prefix_only();
-    loop.sigma1 = rss_ar / sum_w_;
-    loop.sigma_full = rss_full / sum_w_;
-    loop.residual_variance = reg.rss_head(1) / sum_w_;
-    // Every F of this output is the log of an RSS ratio: the ratios first,
-    // then one vectorised log for all of them (a scalar log each costs as
-    // much as a rotation).
-    const auto m = static_cast<Eigen::Index>(n_inputs_);
-    rss_ratios_[0] = rss_ar / rss_full;
-    for (std::size_t i = 0; i < n_inputs_; ++i) {
-      const auto ii = static_cast<Eigen::Index>(i);
-      rss_ratios_[1 + ii] = reg.rss_without_block(i, scratch_) / rss_full;
-      rss_ratios_[1 + m + ii] = reg.rss_pair_prefix_only(i) / reg.rss_pair(i);
-    }
-    log_ratios_ = rss_ratios_.log();
-    loop.lr_joint = scale_full * log_ratios_[0];
-    // The AR parts of every pairwise model, for gamma, in one solve.
-    const Eigen::MatrixXd* pair_prefix = n_inverse_ar_[j] ? &reg.solve_pairs_prefix() : nullptr;
-    for (std::size_t i = 0; i < n_inputs_; ++i) {
-      const auto ii = static_cast<Eigen::Index>(i);
-      ChannelStats& c = channels_[j * n_inputs_ + i];
-      c.f_conditional = log_ratios_[1 + ii];
-      c.lr_conditional = scale_full * c.f_conditional;
-      c.f_pairwise = log_ratios_[1 + m + ii];
-      c.lr_pairwise = scale_pair * c.f_pairwise;
-
-      if (n_inverse_ar_[j]) {
-        // gamma = ||g_hat - g_N||^2 / ||[1, -g_N]||^2: the distance between
-        // the fitted AR part and that of N^-1, relative to the whole N^-1
-        // polynomial (leading 1 included), so a white N (g_N = 0) is fine.
-        const auto& g_n = *n_inverse_ar_[j];
-        const auto g_hat = pair_prefix->col(static_cast<Eigen::Index>(i)).segment(1, static_cast<Eigen::Index>(na_));
-        const double dist = (g_hat - g_n).squaredNorm();
-        c.gamma = dist / (1.0 + g_n.squaredNorm());
-      }
-      if (loop.diverging) c.alarm = false;  // no verdict on a diverging loop
-    }
+    if (loops_[j].diverging)  // no verdict on a diverging loop
+      for (std::size_t i = 0; i < n_inputs_; ++i) channels_[j * n_inputs_ + i].alarm = false;
+    stale_[j] = 1;
     update_detector(j);
   }
   refresh_long_windows();
 }
+
+void GrangerMonitor::refresh_statistics(std::size_t j) const noexcept {
+  if (!stale_[j]) return;
+  stale_[j] = 0;
+  const std::size_t p_full = n_regressors();
+  const std::size_t p_pair = 1 + na_ + nb_;
+  const double scale_full = std::max(n_eq_ - static_cast<double>(p_full), 1.0);
+  const double scale_pair = std::max(n_eq_ - static_cast<double>(p_pair), 1.0);
+  const NestedRls& reg = regressions_[j];
+  LoopStats& loop = loops_[j];
+  const double rss_full = reg.rss_full();
+  const double rss_ar = reg.rss_prefix_only();
+  loop.sigma1 = rss_ar / sum_w_;
+  loop.sigma_full = rss_full / sum_w_;
+  loop.residual_variance = reg.rss_head(1) / sum_w_;
+  // Every F of this output is the log of an RSS ratio: the ratios first,
+  // then one vectorised log for all of them (a scalar log each costs as
+  // much as a rotation).
+  const auto m = static_cast<Eigen::Index>(n_inputs_);
+  rss_ratios_[0] = rss_ar / rss_full;
+  for (std::size_t i = 0; i < n_inputs_; ++i) {
+    const auto ii = static_cast<Eigen::Index>(i);
+    rss_ratios_[1 + ii] = reg.rss_without_block(i, scratch_) / rss_full;
+    rss_ratios_[1 + m + ii] = reg.rss_pair_prefix_only(i) / reg.rss_pair(i);
+  }
+  log_ratios_ = rss_ratios_.log();
+  loop.lr_joint = scale_full * log_ratios_[0];
+  // The AR parts of every pairwise model, for gamma, in one solve.
+  const Eigen::MatrixXd* pair_prefix = n_inverse_ar_[j] ? &reg.solve_pairs_prefix() : nullptr;
+  for (std::size_t i = 0; i < n_inputs_; ++i) {
+    const auto ii = static_cast<Eigen::Index>(i);
+    ChannelStats& c = channels_[j * n_inputs_ + i];
+    c.f_conditional = log_ratios_[1 + ii];
+    c.lr_conditional = scale_full * c.f_conditional;
+    c.f_pairwise = log_ratios_[1 + m + ii];
+    c.lr_pairwise = scale_pair * c.f_pairwise;
+    if (n_inverse_ar_[j]) {
+      // gamma = ||g_hat - g_N||^2 / ||[1, -g_N]||^2: the distance between
+      // the fitted AR part and that of N^-1, relative to the whole N^-1
+      // polynomial (leading 1 included), so a white N (g_N = 0) is fine.
+      const auto& g_n = *n_inverse_ar_[j];
+      const auto g_hat = pair_prefix->col(static_cast<Eigen::Index>(i)).segment(1, static_cast<Eigen::Index>(na_));
+      const double dist = (g_hat - g_n).squaredNorm();
+      c.gamma = dist / (1.0 + g_n.squaredNorm());
+    }
+  }
+}
+
 void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
   if (part.n_inputs_ != n_inputs_ || part.n_outputs_ != n_outputs_ || part.na_ != na_ || part.nb_ != nb_ ||
       part.bank_.lags_needed() != bank_.lags_needed() || part.warmup_ != warmup_)
@@ -239,8 +249,10 @@ void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
   for (std::size_t j = part.first_output_; j < part.end_output_; ++j) {
     regressions_[j] = part.regressions_[j];
     bank_.adopt_output(part.bank_, j);
+    part.refresh_statistics(j);
     for (std::size_t i = 0; i < n_inputs_; ++i) channels_[j * n_inputs_ + i] = part.channels_[j * n_inputs_ + i];
     loops_[j] = part.loops_[j];
+    stale_[j] = 0;
     output_used_[j] = part.output_used_[j];
     output_sum_w_[j] = part.output_sum_w_[j];
     screen_.adopt_output(part.screen_, j);

@@ -95,11 +95,25 @@ class GrangerMonitor {
   // k, residual: n_outputs values of d~ at time k. Returns what was done.
   SampleStatus update(const double* u, const double* residual) noexcept;
 
-  // Statistics as of the last update (refreshed every used sample).
+  // Statistics as of the last update. The RSS-based ones (F, LR, gamma,
+  // the variances) are computed from the factors when first read after a
+  // used sample (refresh_statistics): the same numbers, but a sample nobody
+  // reads costs no solve. So these readers write a cache: not for
+  // concurrent use with each other or with update(). Real-time safe.
   const ChannelStats& channel(std::size_t output, std::size_t input) const noexcept {
+    refresh_statistics(output);
     return channels_[output * n_inputs_ + input];
   }
-  const LoopStats& loop(std::size_t output) const noexcept { return loops_[output]; }
+  const LoopStats& loop(std::size_t output) const noexcept {
+    refresh_statistics(output);
+    return loops_[output];
+  }
+  // A channel's alarm flag alone, computing nothing: for readers of every
+  // sample (AlarmEdges), so a sample whose statistics nobody reads costs no
+  // solve.
+  bool channel_alarm(std::size_t output, std::size_t input) const noexcept {
+    return channels_[output * n_inputs_ + input].alarm;
+  }
   const MonitorCounters& counters() const noexcept { return counters_; }
 
   // Equivalent sample count behind the current statistics.
@@ -143,6 +157,7 @@ class GrangerMonitor {
   // Settings, thresholds and scratch are rebuilt by the constructor.
   template <class V>
   void visit_state(V&& v) {
+    for (std::size_t j = 0; j < n_outputs_; ++j) refresh_statistics(j);  // saved current
     bank_.visit_state(v);
     v(regressions_); v(channels_); v(loops_); v(counters_); v(in_gap_); v(used_since_reset_);
     v(sum_w_); v(sum_w2_); v(n_eq_);
@@ -160,6 +175,9 @@ class GrangerMonitor {
   void absorb_sample(const double* residual) noexcept;
   void update_divergence(const double* residual) noexcept;
   void update_statistics() noexcept;
+  // Output j's RSS-based statistics from its factor, if a used sample
+  // changed the factor since they were last computed.
+  void refresh_statistics(std::size_t j) const noexcept;
   void reset_output(std::size_t j) noexcept;
   // Live alarms (granger_alarms.cpp): the detectors' setup, their score of
   // output j this sample, the long windows' periodic refresh, and what a
@@ -195,15 +213,18 @@ class GrangerMonitor {
   // One per output: the full model [1, AR, u_1 .. u_m] and the pairwise
   // models [1, AR, u_i] in one shared update (nested_rls.hpp).
   std::vector<NestedRls> regressions_;
-  NestedRls::Matrix scratch_;       // scratch for conditional RSS
+  mutable NestedRls::Matrix scratch_;       // scratch for conditional RSS
   // Scratch: one output's RSS ratios [joint, conditional (m), pairwise (m)]
   // and their logarithms, taken in one vectorised call.
-  Eigen::ArrayXd rss_ratios_;
-  Eigen::ArrayXd log_ratios_;
+  mutable Eigen::ArrayXd rss_ratios_;
+  mutable Eigen::ArrayXd log_ratios_;
 
   std::vector<std::optional<Eigen::VectorXd>> n_inverse_ar_;
-  std::vector<ChannelStats> channels_;
-  std::vector<LoopStats> loops_;
+  // Mutable: their RSS-based fields are a cache (refresh_statistics).
+  mutable std::vector<ChannelStats> channels_;
+  mutable std::vector<LoopStats> loops_;
+  // Per output: the factor changed since its statistics were computed.
+  mutable std::vector<std::uint8_t> stale_;
   MonitorCounters counters_;
   bool in_gap_ = false;
   std::uint64_t used_since_reset_ = 0;
