@@ -115,6 +115,15 @@ void update_figures(Plan& plan, const PeakRate& peak, std::int64_t& allocations,
              fmt("thread CPU time, median of %.0f repeats of %.0f updates (fastest %.0f ns); na=20 nb=10 lambda=0.999, all statistics "
                  "and gamma",
                  static_cast<double>(size.repeats), static_cast<double>(size.per_repeat), t.ns_min));
+    if (size.n == 2) {
+      const UpdateTiming live = time_updates(2, 2, size.per_repeat, size.repeats, Reads::kAlarmsOnly);
+      allocations += live.allocations;
+      updates += live.updates;
+      plan.add("update_ns_2x2_alarms_only", live.ns_per_update, "ns",
+               fmt("as update_ns_2x2, reading only the alarm flags after each update as mpmd does per sample "
+                   "(the statistics are computed when read); fastest %.0f ns",
+                   live.ns_min));
+    }
     const MonitorFlops f = monitor_flops(size.n, size.n, s);
     plan.add("flops_per_update_" + tag(size.n), f.total(), "flop",
              fmt("analytic (bench/flops.hpp): multiply and add counted separately (FMA = 2), sqrt, divide, log 1 "

@@ -206,7 +206,7 @@ class AlarmEdges {
   void scan(const GrangerMonitor& m, std::size_t first, std::size_t end, OnEdge&& on_edge) {
     for (std::size_t j = first; j < end; ++j) {
       for (std::size_t i = 0; i < inputs_; ++i) {
-        const std::uint8_t now = m.channel(j, i).alarm ? 1 : 0;
+        const std::uint8_t now = m.channel_alarm(j, i) ? 1 : 0;
         std::uint8_t& was = state_[j * inputs_ + i];
         if (now == was) continue;
         was = now;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <variant>
 
 #include "core/givens.hpp"
 
@@ -28,7 +29,7 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
       cols_(prefix + blocks * block_size + 1),
       lambda_(forgetting),
       delta_(regularization),
-      wald_(wald_tests) {
+      first_pair_(wald_tests ? 0 : 1) {
   if (prefix == 0 || blocks == 0 || block_size == 0)
     throw std::invalid_argument("NestedRls: need a prefix and at least one block of regressors");
   if (!(forgetting > 0.0 && forgetting <= 1.0)) throw std::invalid_argument("NestedRls: forgetting must be in (0, 1]");
@@ -38,9 +39,9 @@ NestedRls::NestedRls(std::size_t prefix, std::size_t blocks, std::size_t block_s
   // reads of a block of B columns may run past the last one.
   top_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(givens::padded(cols_) + givens::kLanes));
   top_d_.resize(static_cast<Eigen::Index>(a_));
-  if (wald_) lower_wald_ = BiermanRls(m_ * nb_, nb_, forgetting, regularization);
+  if (wald_tests) lower_ = BiermanRls(m_ * nb_, nb_, forgetting, regularization);
   else lower_ = UdRls(m_ * nb_, forgetting, regularization);
-  pairs_.assign(wald_ ? m_ : m_ - 1, UdRls(nb_, forgetting, regularization));
+  pairs_.assign(m_ - first_pair_, UdRls(nb_, forgetting, regularization));
   row_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(givens::padded(cols_)));
   apriori_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m_ * nb_ + 1));
   pair_rhs_.resize(static_cast<Eigen::Index>(a_), static_cast<Eigen::Index>(m_));
@@ -54,8 +55,7 @@ void NestedRls::reset() noexcept {
   top_.setZero();
   for (std::size_t i = 0; i < a_; ++i) top_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = 1.0;
   top_d_.setConstant(delta_);
-  if (wald_) lower_wald_.reset();
-  else lower_.reset();
+  std::visit([](auto& lower) { lower.reset(); }, lower_);
   for (UdRls& p : pairs_) p.reset();
   prior_.reset();
   apriori_.setZero();
@@ -72,15 +72,14 @@ void NestedRls::absorb_top(std::size_t first, double lambda) noexcept {
 void NestedRls::stage_lowers() noexcept {
   const double* w = row_.data();
   const double y = w[cols_ - 1];
-  if (wald_) {
-    std::copy(w + a_, w + cols_, lower_wald_.staged_row());  // B_1 .. B_m, y
-    lower_wald_.stage_weight(row_weight_);
-  } else {
-    std::copy(w + a_, w + cols_, lower_.staged_row());
-    lower_.stage_weight(row_weight_);
-  }
+  std::visit(
+      [&](auto& lower) {
+        std::copy(w + a_, w + cols_, lower.staged_row());  // B_1 .. B_m, y
+        lower.stage_weight(row_weight_);
+      },
+      lower_);
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
-    const std::size_t i = wald_ ? k : k + 1;  // the input of pairs_[k]
+    const std::size_t i = first_pair_ + k;  // the input of pairs_[k]
     UdRls& pair = pairs_[k];
     double* q = pair.staged_row();
     std::copy(w + a_ + i * nb_, w + a_ + (i + 1) * nb_, q);
@@ -92,10 +91,9 @@ void NestedRls::stage_lowers() noexcept {
 void NestedRls::add_to_lowers() noexcept {
   const double* w = row_.data();
   const double y = w[cols_ - 1];
-  if (wald_) lower_wald_.add_row(w + a_, y, row_weight_);
-  else lower_.add_row(w + a_, y, row_weight_);
+  std::visit([&](auto& lower) { lower.add_row(w + a_, y, row_weight_); }, lower_);
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
-    const std::size_t i = wald_ ? k : k + 1;
+    const std::size_t i = first_pair_ + k;
     pairs_[k].add_row(w + a_ + i * nb_, y, row_weight_);
   }
 }
@@ -142,8 +140,8 @@ void NestedRls::update_staged(NestedRls* models, std::size_t count) noexcept {
     std::copy(n.row_.data() + n.a_, n.row_.data() + n.cols_, n.apriori_.data());
     n.apriori_weight_ = n.row_weight_;
     n.stage_lowers();
-    if (n.wald_) n.lower_wald_.update_staged();
-    else add(n.lower_);
+    if (auto* wald = std::get_if<BiermanRls>(&n.lower_)) wald->update_staged();
+    else add(std::get<UdRls>(n.lower_));
     for (UdRls& p : n.pairs_) add(p);
   }
   if (in_group > 0) UdRls::update_staged(group, in_group);
@@ -170,18 +168,19 @@ double NestedRls::rss_head(std::size_t k) const noexcept {
 }
 
 double NestedRls::rss_pair(std::size_t i) const noexcept {
-  return i == 0 && !wald_ ? lower_.rss_prefix(nb_) : pair(i).rss();
+  return i < first_pair_ ? information_lower()->rss_prefix(nb_) : pairs_[i - first_pair_].rss();
 }
 
 double NestedRls::rss_pair_prefix_only(std::size_t i) const noexcept {
-  return i == 0 && !wald_ ? lower_.rss_prefix(0) : pair(i).rss_prefix(0);
+  return pair_factor(i).rss_prefix(0);
 }
 
 double NestedRls::rss_without_block(std::size_t i, Matrix& scratch) const noexcept {
   if (m_ == 1) return rss_prefix_only();
   // Two inputs: the model without one is the pairwise model of the other.
   if (m_ == 2) return rss_pair(1 - i);
-  return wald_ ? lower_wald_.rss_without_block(i, scratch) : lower_.rss_without(i * nb_, nb_, scratch);
+  if (const UdRls* ud = information_lower()) return ud->rss_without(i * nb_, nb_, scratch);
+  return std::get<BiermanRls>(lower_).rss_without_block(i, scratch);
 }
 
 void NestedRls::solve_top_unit(const double* rhs, std::size_t count, double* out, std::size_t out_stride) const noexcept {
@@ -235,8 +234,7 @@ const Eigen::MatrixXd& NestedRls::solve_pairs_prefix() const noexcept {
   // beta_B_i of every pairwise model, each zero-padded to whole lanes.
   for (std::size_t i = 0; i < m_; ++i) {
     double* beta_b = pair_beta_b_.col(static_cast<Eigen::Index>(i)).data();
-    if (i == 0 && !wald_) lower_.solve_prefix_padded(nb_, beta_b);
-    else pair(i).solve_prefix_padded(nb_, beta_b);
+    pair_factor(i).solve_prefix_padded(nb_, beta_b);
   }
   // Right-hand sides U_Ay - U_AB_i beta_B_i, one column each: a dot product
   // of whole lanes per row (the lanes past B_i meet beta's zero padding;
@@ -285,27 +283,27 @@ const Eigen::MatrixXd& NestedRls::solve_pairs_prefix() const noexcept {
 
 void NestedRls::solve_pair_prefix(std::size_t i, Eigen::Ref<Eigen::VectorXd> out) const noexcept {
   auto beta_b = coef_b_.head(static_cast<Eigen::Index>(nb_));
-  if (i == 0 && !wald_) lower_.solve_prefix(nb_, beta_b);
-  else pair(i).solve_prefix(nb_, beta_b);
+  pair_factor(i).solve_prefix(nb_, beta_b);
   solve_top(i * nb_, nb_, beta_b.data(), out.data());
 }
 
 void NestedRls::solve_full(Eigen::Ref<Eigen::VectorXd> out) const noexcept {
-  if (wald_) coef_b_ = lower_wald_.coefficients();
-  else lower_.solve_prefix(m_ * nb_, coef_b_);
+  if (const UdRls* ud = information_lower()) ud->solve_prefix(m_ * nb_, coef_b_);
+  else coef_b_ = std::get<BiermanRls>(lower_).coefficients();
   solve_top(0, m_ * nb_, coef_b_.data(), out.data());
   std::copy(coef_b_.data(), coef_b_.data() + m_ * nb_, out.data() + a_);
 }
 
 double NestedRls::information_quadratic(const double* s, double* z) const noexcept {
   const std::size_t d = m_ * nb_;
-  if (wald_) return lower_wald_.covariance_quadratic(s);
+  const UdRls* ud = information_lower();
+  if (!ud) return std::get<BiermanRls>(lower_).covariance_quadratic(s);
   // S = U^T D U over the first d regressors: z = U^-T s by forward
   // substitution (rows of U are contiguous), then sum z_i^2 / D_i.
-  const auto u = lower_.unit_factor();
+  const auto u = ud->unit_factor();
   const double* base = u.data();
   const auto ld = static_cast<std::size_t>(u.outerStride());
-  const Eigen::VectorXd& dd = lower_.weights();
+  const Eigen::VectorXd& dd = ud->weights();
   std::copy(s, s + d, z);
   double q = 0.0;
   for (std::size_t i = 0; i < d; ++i) {
@@ -319,16 +317,17 @@ double NestedRls::information_quadratic(const double* s, double* z) const noexce
 
 void NestedRls::inputs_covariance(double* out, std::size_t ld) const noexcept {
   const std::size_t d = m_ * nb_;
-  if (wald_) {
-    lower_wald_.covariance_into(out, ld);
+  const UdRls* ud = information_lower();
+  if (!ud) {
+    std::get<BiermanRls>(lower_).covariance_into(out, ld);
     return;
   }
   // P = U^-1 D^-1 U^-T: V = U^-1 column by column into the upper triangle of
   // out (back substitution), then P_ab = sum_j V_aj V_bj / D_j.
-  const auto u = lower_.unit_factor();
+  const auto u = ud->unit_factor();
   const double* base = u.data();
   const auto lu = static_cast<std::size_t>(u.outerStride());
-  const Eigen::VectorXd& dd = lower_.weights();
+  const Eigen::VectorXd& dd = ud->weights();
   const auto v = [&](std::size_t a, std::size_t j) -> double& { return out[a + j * ld]; };
   for (std::size_t j = 0; j < d; ++j) {
     v(j, j) = 1.0;
@@ -356,8 +355,9 @@ void NestedRls::inputs_information(double* out, std::size_t ld) const noexcept {
   // times row i of U, so S = sum_i D_i u_i^T u_i, one rank-one update per row
   // on the upper triangle (row i of U is zero before column i), mirrored.
   const auto d = static_cast<Eigen::Index>(m_ * nb_);
-  const auto u = lower_.unit_factor();
-  const Eigen::VectorXd& dd = lower_.weights();
+  const UdRls& lower = std::get<UdRls>(lower_);
+  const auto u = lower.unit_factor();
+  const Eigen::VectorXd& dd = lower.weights();
   Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> s(out, d, d, Eigen::OuterStride<>(static_cast<Eigen::Index>(ld)));
   s.setZero();
   for (Eigen::Index i = 0; i < d; ++i) {

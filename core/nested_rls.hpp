@@ -24,6 +24,7 @@
 // factor is kept in covariance form instead (bierman_rls.hpp), which gives
 // every block's conditional RSS by the Wald identity; it has no prefix
 // models, so the first input's pairwise model gets a factor of its own too.
+// The lower factor is one of the two (a variant), fixed at setup.
 //
 // Priors: the A directions' prior lives in the trapezoid and is kept alive as
 // in every factor (rls_common.hpp: a unit row every K samples, absorbed without forgetting and
@@ -32,6 +33,7 @@
 #pragma once
 
 #include <cstddef>
+#include <variant>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -72,9 +74,14 @@ class NestedRls {
   // of the model of the first k <= prefix() regressors of A,
   double rss_head(std::size_t k) const noexcept;
   // of the model of A alone (the paper's Sigma1 times the weight sum),
-  double rss_prefix_only() const noexcept { return wald_ ? lower_wald_.rss_empty() : lower_.rss_prefix(0); }
+  double rss_prefix_only() const noexcept {
+    const UdRls* ud = information_lower();
+    return ud ? ud->rss_prefix(0) : std::get<BiermanRls>(lower_).rss_empty();
+  }
   // of the full model,
-  double rss_full() const noexcept { return wald_ ? lower_wald_.rss() : lower_.rss(); }
+  double rss_full() const noexcept {
+    return std::visit([](const auto& lower) { return lower.rss(); }, lower_);
+  }
   // of the pairwise model [A, B_i] and of its own A-only part (equal to
   // rss_prefix_only() but for the rounding and priors of its own factor),
   double rss_pair(std::size_t i) const noexcept;
@@ -110,7 +117,7 @@ class NestedRls {
   // S itself (information form only: !wald_tests), m nb x m nb column major.
   // O((m nb)^3) real-time safe: for a periodic refresh.
   void inputs_information(double* out, std::size_t ld) const noexcept;
-  bool covariance_form() const noexcept { return wald_; }
+  bool covariance_form() const noexcept { return std::holds_alternative<BiermanRls>(lower_); }
   // S^-1 (m nb x m nb, column major, leading dimension ld). O((m nb)^3),
   // real-time safe: for a raise, not for every sample.
   void inputs_covariance(double* out, std::size_t ld) const noexcept;
@@ -120,9 +127,20 @@ class NestedRls {
 
   // Calls v(member) for every member that changes after setup, in a fixed
   // order: what a checkpoint saves and restores (daemon/mpmd/checkpoint.hpp).
+  // The lower factor is saved in the place of its form, an empty factor in
+  // that of the other (the layout of checkpoints written before the two
+  // forms were one variant, so those still load).
   template <class V>
   void visit_state(V&& v) {
-    v(prior_); v(top_); v(top_d_); v(lower_); v(lower_wald_); v(pairs_);
+    v(prior_); v(top_); v(top_d_);
+    if (UdRls* ud = std::get_if<UdRls>(&lower_)) {
+      BiermanRls none;
+      v(*ud); v(none);
+    } else {
+      UdRls none;
+      v(none); v(std::get<BiermanRls>(lower_));
+    }
+    v(pairs_);
     v(row_); v(row_weight_); v(apriori_); v(apriori_weight_);
   }
 
@@ -133,13 +151,14 @@ class NestedRls {
   std::size_t cols_ = 0;          // a + m nb + 1
   double lambda_ = 1.0;
   double delta_ = 1e-9;
-  bool wald_ = false;             // the full lower factor in covariance form
   KeptAlivePrior prior_;           // over the rows of A (the lower factors keep their own)
   Matrix top_;                    // a x (padded cols + lanes): the A rows of U, [U_AA U_AB U_Ay]
   Eigen::VectorXd top_d_;         // their weights (D)
-  UdRls lower_;                   // [B_1 .. B_m | y] given A (unless wald_)
-  BiermanRls lower_wald_;         // the same in covariance form (wald_)
-  std::vector<UdRls> pairs_;      // [B_i | y] given A, i = 2..m (i = 1..m with wald_)
+  // [B_1 .. B_m | y] given A: information form (its prefix [B_1 | y] is the
+  // first pairwise model) or covariance form (Wald tests).
+  std::variant<UdRls, BiermanRls> lower_;
+  std::vector<UdRls> pairs_;      // [B_i | y] given A, i = 2..m (i = 1..m in covariance form)
+  std::size_t first_pair_ = 1;    // the input of pairs_[0]: 1, or 0 in covariance form
   Eigen::VectorXd row_;           // staged row, cols values
   double row_weight_ = 1.0;       // its weight after the trapezoid's rotations
   Eigen::VectorXd apriori_;       // the last sample's row as the trapezoid left it (m nb + 1)
@@ -149,8 +168,15 @@ class NestedRls {
   mutable Eigen::MatrixXd pair_rhs_;     // a x m: U_Ay - U_AB_i beta_B_i
   mutable Eigen::MatrixXd pair_prefix_;  // padded(a) x m: solve_pairs_prefix's result
 
-  // The pairwise factor of input i >= 1 (i >= 0 with wald_).
-  const UdRls& pair(std::size_t i) const noexcept { return pairs_[wald_ ? i : i - 1]; }
+  // The lower factor in information form, or null in covariance form.
+  const UdRls* information_lower() const noexcept { return std::get_if<UdRls>(&lower_); }
+  // The factor of pairwise model i: the prefix of the information-form
+  // lower factor for i = 0, else its own (its first nb regressors are B_i's
+  // either way).
+  const UdRls& pair_factor(std::size_t i) const noexcept {
+    const UdRls* ud = information_lower();
+    return i < first_pair_ ? *ud : pairs_[i - first_pair_];
+  }
   // Rotates row_ through the trapezoid rows [first, a), forgetting lambda.
   void absorb_top(std::size_t first, double lambda) noexcept;
   // Hands what is left of row_ to the lower factors as their staged rows.

@@ -455,6 +455,61 @@ TEST(GrangerMonitor, PartsOfTheOutputsEqualTheWholeMonitor) {
   EXPECT_THROW(other.adopt_outputs(first), std::invalid_argument);
 }
 
+// The RSS-based statistics are computed when read (refresh_statistics):
+// a monitor read only now and then shows, at each read, exactly what a
+// monitor read after every sample shows, across warm-up, a gap, an outlier
+// and a raise; and reading them allocates nothing.
+TEST(GrangerMonitor, StatisticsReadLateEqualStatisticsReadEverySample) {
+  const MonitorSettings s = test_settings();
+  GrangerMonitor every(2, 2, s, wood_berry_noise(s.ar_order));
+  GrangerMonitor late(2, 2, s, wood_berry_noise(s.ar_order));
+  PlantedRun run(11);
+  run.dg[1][0].emplace(DiscreteTf{{0.4}, {1, -0.6}, 2});
+  std::vector<double> us, ds;
+  for (int k = 0; k < 8000; ++k) {
+    run.step();
+    us.insert(us.end(), run.u, run.u + 2);
+    ds.insert(ds.end(), run.d, run.d + 2);
+  }
+  ds[2 * 3000] = NAN;            // a gap
+  ds[2 * 5000 + 1] += 1e3;       // an outlier
+  std::vector<ChannelStats> seen(4);
+  std::vector<LoopStats> seen_loop(2);
+  int compared = 0;
+  long allocations = 0;
+  for (std::size_t k = 0; k < 8000; ++k) {
+    every.update(&us[2 * k], &ds[2 * k]);
+    {
+      test::AllocationScope scope;
+      for (std::size_t j = 0; j < 2; ++j) {
+        seen_loop[j] = every.loop(j);
+        for (std::size_t i = 0; i < 2; ++i) seen[j * 2 + i] = every.channel(j, i);
+      }
+      allocations += scope.count();
+    }
+    late.update(&us[2 * k], &ds[2 * k]);
+    if (k % 997 != 0 && k != 3000 && k != 3001 && k != 5000 && k != 7999) continue;
+    ++compared;
+    for (std::size_t j = 0; j < 2; ++j) {
+      EXPECT_EQ(late.loop(j).lr_joint, seen_loop[j].lr_joint) << "sample " << k;
+      EXPECT_EQ(late.loop(j).residual_variance, seen_loop[j].residual_variance) << "sample " << k;
+      for (std::size_t i = 0; i < 2; ++i) {
+        const ChannelStats& c = late.channel(j, i);
+        EXPECT_EQ(c.f_conditional, seen[j * 2 + i].f_conditional) << "sample " << k;
+        EXPECT_EQ(c.lr_pairwise, seen[j * 2 + i].lr_pairwise) << "sample " << k;
+        EXPECT_TRUE(c.gamma == seen[j * 2 + i].gamma || (std::isnan(c.gamma) && std::isnan(seen[j * 2 + i].gamma)))
+            << "sample " << k;
+        EXPECT_EQ(c.alarm, seen[j * 2 + i].alarm) << "sample " << k;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 13);
+  EXPECT_EQ(allocations, 0);
+  EXPECT_EQ(late.counters().outliers, 1u);
+  EXPECT_TRUE(late.channel(1, 0).alarm);  // the planted channel raised: a real run
+  EXPECT_GT(late.channel(1, 0).lr_conditional, late.raise_threshold());
+}
+
 TEST(MonitorSettings, ValidateNamesTheField) {
   MonitorSettings s;
   s.forgetting = 1.5;

@@ -87,4 +87,23 @@ TEST(DependencyRules, EveryFolderIncludesOnlyWhatTheReadmeAllows) {
   EXPECT_EQ(breaches_seen, kKnownBreaches) << "a known breach is gone: remove it from kKnownBreaches";
 }
 
+// core/ is two libraries (core/CMakeLists.txt): the offline diagnosis
+// (diagnosis*, decussation*) builds on the real-time monitor, never the
+// reverse, so mpmd's per-sample path links no diagnosis code.
+bool in_diagnosis_library(const std::string& path) {
+  const std::string name = fs::path(path).filename().string();
+  return name.rfind("diagnosis", 0) == 0 || name.rfind("decussation", 0) == 0;
+}
+
+TEST(DependencyRules, TheMonitorLibraryIncludesNothingOfTheDiagnosis) {
+  int monitor_includes = 0;
+  for (const Include& inc : includes_under("core")) {
+    if (inc.angled || in_diagnosis_library(inc.file) || inc.target.rfind("core/", 0) != 0) continue;
+    ++monitor_includes;
+    EXPECT_FALSE(in_diagnosis_library(inc.target))
+        << inc.file << " includes \"" << inc.target << "\": the monitor library (mpm_core) may not use the diagnosis (mpm_diagnosis)";
+  }
+  EXPECT_GT(monitor_includes, 20);  // the monitor's files were found and read
+}
+
 }  // namespace

@@ -10,9 +10,12 @@ DESTDIR="$work/root" cmake --install "$build" --prefix /usr --component dev >"$w
 # lib/ or lib/<multiarch>/, as GNUInstallDirs chose for the prefix at configure time.
 config=$(find "$work/root/usr" -name mpmConfig.cmake)
 for f in "$config" "$(dirname "$config")/mpmTargets.cmake" "$work/root/usr/include/mpm/core/granger_monitor.hpp" \
-         "$(find "$work/root/usr" -name libmpm_core.a)"; do
+         "$(find "$work/root/usr" -name libmpm_core.a)" "$(find "$work/root/usr" -name libmpm_diagnosis.a)"; do
   [ -n "$f" ] && [ -e "$f" ] || { echo "FAIL: not installed: $f"; cat "$work/install.log"; exit 1; }
 done
+# Both libraries are exported, the diagnosis on top of the monitor.
+grep -q "add_library(mpm::diagnosis STATIC IMPORTED)" "$(dirname "$config")/mpmTargets.cmake" ||
+  { echo "FAIL: mpm::diagnosis is not exported"; exit 1; }
 # The installed interface names no build or source folder and no instruction-set flag.
 if grep -n "$src\|$build\|-march" "$(dirname "$config")"/*.cmake; then
   echo "FAIL: the exported targets refer to the build tree or carry -march"; exit 1
