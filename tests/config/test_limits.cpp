@@ -24,14 +24,7 @@ namespace {
 using testing_util::temp_dir;
 using testing_util::write_text;
 
-std::string error_of(auto&& load) {
-  try {
-    load();
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+std::string error_of(auto&& load) { return testing_util::config_error(load); }
 
 std::string names(const char* prefix, std::size_t n) {
   std::string out = "[";

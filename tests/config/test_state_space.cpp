@@ -12,17 +12,14 @@
 #include <gtest/gtest.h>
 
 #include "config/plant_loader.hpp"
+#include "config_test_util.hpp"
 #include "core/transfer_function.hpp"
+#include "support/tf_step.hpp"
 
 namespace mpm::config {
 namespace {
 
-std::vector<double> tf_step(const DiscreteTf& tf, int steps) {
-  DiscreteFilter f(tf);
-  std::vector<double> y;
-  for (int k = 0; k < steps; ++k) y.push_back(f.step(1.0));
-  return y;
-}
+using test::tf_step;
 
 const ChannelModel* find(const PlantModel& p, std::size_t j, std::size_t i) { return p.channel(j, i); }
 
@@ -157,35 +154,29 @@ state_space:
   }
 }
 
-std::string load_error(const std::string& yaml) {
-  try {
-    (void)parse_plant(yaml, "bad.yaml");
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(StateSpace, ShapeAndStabilityErrorsAreLocated) {
   const std::string head = "plant: x\nsample_time: 1\ninputs: [u1]\noutputs: [y1]\n";
-  EXPECT_NE(load_error(head + "state_space:\n  discrete: true\n  A: [[0.5, 0]]\n  B: [[1]]\n  C: [[1]]\n")
-                .find("bad.yaml:7:7: state_space.A[0]: expected 1 numbers in each row of a 1 x 1 matrix, got 2"),
-            std::string::npos);
-  EXPECT_NE(load_error(head + "state_space:\n  discrete: true\n  A: [[0.5]]\n  B: [[1, 2]]\n  C: [[1]]\n")
-                .find("state_space.B[0]: expected 1 numbers in each row"),
-            std::string::npos);
-  EXPECT_NE(load_error(head + "state_space:\n  discrete: yes\n  A: [[0.5]]\n  B: [[1]]\n  C: [[1]]\n")
-                .find("state_space.discrete: expected true"),
-            std::string::npos);
-  EXPECT_NE(load_error(head + "state_space:\n  discrete: true\n  A: [[1.5]]\n  B: [[1]]\n  C: [[1]]\n")
-                .find("state_space.A: expected a stable or integrating model"),
-            std::string::npos);
-  EXPECT_NE(load_error(head + "model: []\nstate_space:\n  discrete: true\n  A: [[0.5]]\n  B: [[1]]\n  C: [[1]]\n")
-                .find("give the model as `model:` channels or as `state_space:`, not both"),
-            std::string::npos);
-  EXPECT_NE(load_error(head + "state_space:\n  discrete: true\n  A: [[0.5]]\n  B: [[1]]\n  C: [[1]]\n  G: [[1]]\n")
-                .find("state_space.noise: missing: G needs noise"),
-            std::string::npos);
+  struct Case {
+    std::string yaml;  // after `head`
+    std::string error;  // a part of the message
+  };
+  const Case cases[] = {
+      {"state_space:\n  discrete: true\n  A: [[0.5, 0]]\n  B: [[1]]\n  C: [[1]]\n",
+       "bad.yaml:7:7: state_space.A[0]: expected 1 numbers in each row of a 1 x 1 matrix, got 2"},
+      {"state_space:\n  discrete: true\n  A: [[0.5]]\n  B: [[1, 2]]\n  C: [[1]]\n",
+       "state_space.B[0]: expected 1 numbers in each row"},
+      {"state_space:\n  discrete: yes\n  A: [[0.5]]\n  B: [[1]]\n  C: [[1]]\n", "state_space.discrete: expected true"},
+      {"state_space:\n  discrete: true\n  A: [[1.5]]\n  B: [[1]]\n  C: [[1]]\n",
+       "state_space.A: expected a stable or integrating model"},
+      {"model: []\nstate_space:\n  discrete: true\n  A: [[0.5]]\n  B: [[1]]\n  C: [[1]]\n",
+       "give the model as `model:` channels or as `state_space:`, not both"},
+      {"state_space:\n  discrete: true\n  A: [[0.5]]\n  B: [[1]]\n  C: [[1]]\n  G: [[1]]\n",
+       "state_space.noise: missing: G needs noise"},
+  };
+  for (const Case& c : cases) {
+    const std::string e = testing_util::config_error([&] { (void)parse_plant(head + c.yaml, "bad.yaml"); });
+    EXPECT_NE(e.find(c.error), std::string::npos) << c.yaml << " -> " << e;
+  }
 }
 
 }  // namespace
