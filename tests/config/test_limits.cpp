@@ -159,7 +159,7 @@ TEST(StrictModes, PrivateFilesAreAccepted) {
 }
 
 TEST(StrictModes, GroupOrWorldWritableConfigIsRefused) {
-  for (const mode_t mode : {0666, 0620, 0602}) {
+  for (const mode_t mode : {mode_t{0666}, mode_t{0620}, mode_t{0602}}) {
     const DaemonFiles f = daemon_files("strict_cfg");
     ::chmod(f.config.c_str(), mode);
     const std::string e = error_of([&] { load_daemon_config(f.config.string()); });

@@ -175,7 +175,7 @@ TEST_P(PlantErrors, MessageNamesFileLineKeyAndExpectation) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, PlantErrors, ::testing::ValuesIn(error_cases()),
-                         [](const auto& info) { return info.param.name; });
+                         [](const auto& test) { return test.param.name; });
 
 TEST(PlantErrorsFromFiles, MessageNamesThePathGiven) {
   const auto path = testing_util::temp_dir("plant_errors") / "typo.yaml";

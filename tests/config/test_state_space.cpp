@@ -57,7 +57,8 @@ TEST(StateSpace, DiscreteStepResponsesEqualTheRecursion) {
       const ChannelModel* ch = find(p, j, i);
       ASSERT_NE(ch, nullptr) << j << i;
       const std::vector<double> s = tf_step(ch->tf, 60);
-      for (int k = 0; k < 60; ++k) EXPECT_NEAR(s[k], y[k][static_cast<Eigen::Index>(j)], 1e-10) << j << i << " k " << k;
+      for (std::size_t k = 0; k < 60; ++k)
+        EXPECT_NEAR(s[k], y[k][static_cast<Eigen::Index>(j)], 1e-10) << j << i << " k " << k;
     }
   }
 }
@@ -96,7 +97,8 @@ state_space:
       const std::vector<double> s = tf_step(ch->tf, 40);
       // A step applied at sample 0 reaches the sampled output one sample later.
       EXPECT_NEAR(s[0], 0.0, 1e-12);
-      for (int k = 1; k < 40; ++k) EXPECT_NEAR(s[k], y[k][static_cast<Eigen::Index>(j)], 1e-9) << j << i << " k " << k;
+      for (std::size_t k = 1; k < 40; ++k)
+        EXPECT_NEAR(s[k], y[k][static_cast<Eigen::Index>(j)], 1e-9) << j << i << " k " << k;
     }
   }
 }
@@ -111,7 +113,7 @@ TEST(StateSpace, TheQuadTankAsAStateSpaceHasTheTransferFunctionFilesChannels) {
     // Shared roots cancelled: the first-order channels stay first order.
     ASSERT_EQ(got->tf.den.size(), want.tf.den.size()) << want.output << want.input;
     const std::vector<double> a = tf_step(got->tf, 200), b = tf_step(want.tf, 200);
-    for (int k = 0; k < 200; ++k) EXPECT_NEAR(a[k], b[k], 1e-8 * (1 + std::abs(b[k]))) << k;
+    for (std::size_t k = 0; k < 200; ++k) EXPECT_NEAR(a[k], b[k], 1e-8 * (1 + std::abs(b[k]))) << k;
   }
 }
 
