@@ -68,8 +68,12 @@ BENCHMARK(BM_Replay2x2)->Arg(1000000)->Iterations(1)->Unit(benchmark::kSecond);
 // Parts of the update, for profiling: one update of each factor kind (p
 // regressors; range(1) = 1: forgetting 0.999 with the prior row, 0: lambda =
 // 1), and one conditional RSS (rss_without of the first input block).
-template <typename Factor>
-void update_factor(benchmark::State& state, Factor& rls, std::size_t p) {
+// make(p, lambda) builds the factor, flops(p, lambda) counts one update's flops.
+template <typename Make, typename Flops>
+void update_factor(benchmark::State& state, Make make, Flops flops) {
+  const auto p = static_cast<std::size_t>(state.range(0));
+  const double lambda = state.range(1) ? 0.999 : 1.0;
+  auto rls = make(p, lambda);
   const Workload w = make_workload(p, 1, 512);
   std::size_t k = 0;
   for (auto _ : state) {
@@ -77,33 +81,28 @@ void update_factor(benchmark::State& state, Factor& rls, std::size_t p) {
     ++k;
   }
   benchmark::DoNotOptimize(rls.rss());
+  state.counters["flops"] = flops(p, lambda);
 }
 
 void BM_SqrtRlsUpdate(benchmark::State& state) {
-  const auto p = static_cast<std::size_t>(state.range(0));
-  const double lambda = state.range(1) ? 0.999 : 1.0;
-  SqrtRls rls(p, lambda, 1e-9);
-  update_factor(state, rls, p);
-  state.counters["flops"] = sqrt_rls_update_flops(p, lambda);
+  update_factor(
+      state, [](std::size_t p, double lambda) { return SqrtRls(p, lambda, 1e-9); },
+      [](std::size_t p, double lambda) { return sqrt_rls_update_flops(p, lambda); });
 }
 BENCHMARK(BM_SqrtRlsUpdate)->ArgsProduct({{31, 41, 520}, {0, 1}});
 
 void BM_UdRlsUpdate(benchmark::State& state) {
-  const auto p = static_cast<std::size_t>(state.range(0));
-  const double lambda = state.range(1) ? 0.999 : 1.0;
-  UdRls rls(p, lambda, 1e-9);
-  update_factor(state, rls, p);
-  state.counters["flops"] = ud_rls_update_flops(p, lambda);
+  update_factor(
+      state, [](std::size_t p, double lambda) { return UdRls(p, lambda, 1e-9); },
+      [](std::size_t p, double lambda) { return ud_rls_update_flops(p, lambda); });
 }
 BENCHMARK(BM_UdRlsUpdate)->ArgsProduct({{31, 41, 520}, {0, 1}});
 
 // The monitor's lower factor from 4 inputs on (blocks of nb = 10).
 void BM_BiermanRlsUpdate(benchmark::State& state) {
-  const auto p = static_cast<std::size_t>(state.range(0));
-  const double lambda = state.range(1) ? 0.999 : 1.0;
-  BiermanRls rls(p, 10, lambda, 1e-9);
-  update_factor(state, rls, p);
-  state.counters["flops"] = bierman_update_flops(p, 10, lambda);
+  update_factor(
+      state, [](std::size_t p, double lambda) { return BiermanRls(p, 10, lambda, 1e-9); },
+      [](std::size_t p, double lambda) { return bierman_update_flops(p, 10, lambda); });
 }
 BENCHMARK(BM_BiermanRlsUpdate)->ArgsProduct({{40, 500}, {0, 1}});
 

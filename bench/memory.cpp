@@ -202,19 +202,19 @@ class Measurement {
     m.pid = child_.pid();
     m.url = lcm_.url;
     if (!wait_ready()) return std::nullopt;
-    const std::optional<ProcMemory> at_ready = read_proc_memory(m.pid);
-    if (!at_ready) {
-      fail("cannot read /proc/" + std::to_string(m.pid) + "/status");
-      return std::nullopt;
-    }
+    // The child's memory now, or the failure said.
+    const auto read_memory = [&]() -> std::optional<ProcMemory> {
+      std::optional<ProcMemory> now = read_proc_memory(m.pid);
+      if (!now) fail("cannot read /proc/" + std::to_string(m.pid) + "/status");
+      return now;
+    };
+    const std::optional<ProcMemory> at_ready = read_memory();
+    if (!at_ready) return std::nullopt;
     m.ready_rss_mb = at_ready->vm_rss_mb;
     m.ready_anon_mb = at_ready->rss_anon_mb;
     if (!feed()) return std::nullopt;
-    const std::optional<ProcMemory> after = read_proc_memory(m.pid);
-    if (!after) {
-      fail("cannot read /proc/" + std::to_string(m.pid) + "/status");
-      return std::nullopt;
-    }
+    const std::optional<ProcMemory> after = read_memory();
+    if (!after) return std::nullopt;
     m.rss_mb = after->vm_rss_mb;
     m.hwm_mb = after->vm_hwm_mb;
     m.anon_mb = after->rss_anon_mb;

@@ -26,8 +26,8 @@ struct ChannelEdit {
   bool add_integrator = false;        // G_P = G_M / s (continuous) or G_M Ts/(1-q^-1)
   // The plant channel is this instead of the model's (a missing channel, a
   // changed structure); the edits above then apply to it.
-  std::optional<ContinuousTf> replace_continuous;
-  std::optional<DiscreteTf> replace_discrete;
+  std::optional<ContinuousTf> replace_continuous{};  // {}: an edit may be written {.output, .input, .gain_factor}
+  std::optional<DiscreteTf> replace_discrete{};
 
   bool changes_nothing() const;
 };

@@ -6,13 +6,14 @@
 #include <utility>
 
 namespace mpm::sim {
-namespace {
 
 std::size_t index_of(const std::vector<std::string>& names, const std::string& name, const char* what) {
   const auto it = std::find(names.begin(), names.end(), name);
   if (it == names.end()) throw std::invalid_argument(std::string("unknown ") + what + " '" + name + "'");
   return static_cast<std::size_t>(it - names.begin());
 }
+
+namespace {
 
 }  // namespace
 

@@ -17,6 +17,11 @@ struct LinearChannel {
   DiscreteTf tf;  // y_output(k) += tf u_input(k); must be strictly proper
 };
 
+// The position of `name` in `names`; throws std::invalid_argument "unknown
+// <what> '<name>'" when it is not there (an edit naming a signal the plant
+// does not have).
+std::size_t index_of(const std::vector<std::string>& names, const std::string& name, const char* what);
+
 // The model's channels with `edits` applied (matched by output/input name).
 // Edits naming unknown signals, or editing one channel twice, throw
 // std::invalid_argument.

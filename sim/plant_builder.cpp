@@ -10,12 +10,6 @@
 namespace mpm::sim {
 namespace {
 
-std::size_t index_of(const std::vector<std::string>& names, const std::string& name, const char* what) {
-  const auto it = std::find(names.begin(), names.end(), name);
-  if (it == names.end()) throw std::invalid_argument(std::string("unknown ") + what + " '" + name + "'");
-  return static_cast<std::size_t>(it - names.begin());
-}
-
 // Extra inputs become further process inputs n_inputs, n_inputs+1, ...
 void add_extra_channels(const PlantModel& model, const PlantSpec& spec, std::vector<LinearChannel>& channels) {
   for (std::size_t x = 0; x < spec.extra_inputs.size(); ++x) {

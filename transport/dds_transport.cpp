@@ -7,6 +7,7 @@
 #include <atomic>
 #include <map>
 #include <mutex>
+#include <type_traits>
 
 #include <dds/dds.h>
 
@@ -101,29 +102,19 @@ class DdsTransport final : public Transport {
   }
 
   bool subscribe_samples(SampleHandler handler) override {
-    const QosHolder qos(dds_qos::sample(settings_.sample_history));
-    if (!add_reader(sample_topic(), qos.get(), sample_reader_)) return false;
-    on_sample_ = std::move(handler);
-    return true;
+    return subscribe(sample_topic(), dds_qos::sample(settings_.sample_history), sample_reader_, on_sample_,
+                     std::move(handler));
   }
   bool subscribe_alarms(AlarmHandler handler) override {
-    const QosHolder qos(dds_qos::alarm_reader());
-    if (!add_reader(alarm_topic(), qos.get(), alarm_reader_)) return false;
-    on_alarm_ = std::move(handler);
-    return true;
+    return subscribe(alarm_topic(), dds_qos::alarm_reader(), alarm_reader_, on_alarm_, std::move(handler));
   }
   bool subscribe_status(StatusHandler handler) override {
-    const QosHolder qos(dds_qos::status_reader());
-    if (!add_reader(status_topic(), qos.get(), status_reader_)) return false;
-    on_status_ = std::move(handler);
-    return true;
+    return subscribe(status_topic(), dds_qos::status_reader(), status_reader_, on_status_, std::move(handler));
   }
   // Diagnoses travel with the alarms' QoS (reliable, transient-local).
   bool subscribe_diagnoses(DiagnosisHandler handler) override {
-    const QosHolder qos(dds_qos::alarm_reader());
-    if (!add_reader(diagnosis_topic(), qos.get(), diagnosis_reader_)) return false;
-    on_diagnosis_ = std::move(handler);
-    return true;
+    return subscribe(diagnosis_topic(), dds_qos::alarm_reader(), diagnosis_reader_, on_diagnosis_,
+                     std::move(handler));
   }
 
   bool advertise(Topic topic) override {
@@ -131,37 +122,11 @@ class DdsTransport final : public Transport {
     return writer(topic) > 0;
   }
 
-  bool publish(const msg::Sample& sample) override {
-    std::lock_guard lock(publish_mutex_);
-    const dds_entity_t w = writer(Topic::kSample);
-    if (w <= 0) return false;
-    mpm_dds_Sample wire{};
-    dds_codec::to_wire(sample, wire, scratch_);
-    return dds_write(w, &wire) == DDS_RETCODE_OK;
-  }
-  bool publish(const msg::Alarm& alarm) override {
-    std::lock_guard lock(publish_mutex_);
-    const dds_entity_t w = writer(Topic::kAlarm);
-    if (w <= 0) return false;
-    mpm_dds_Alarm wire{};
-    dds_codec::to_wire(alarm, wire);
-    return dds_write(w, &wire) == DDS_RETCODE_OK;
-  }
-  bool publish(const msg::Status& status) override {
-    std::lock_guard lock(publish_mutex_);
-    const dds_entity_t w = writer(Topic::kStatus);
-    if (w <= 0) return false;
-    mpm_dds_Status wire{};
-    dds_codec::to_wire(status, wire, scratch_);
-    return dds_write(w, &wire) == DDS_RETCODE_OK;
-  }
+  bool publish(const msg::Sample& sample) override { return write<mpm_dds_Sample>(Topic::kSample, sample); }
+  bool publish(const msg::Alarm& alarm) override { return write<mpm_dds_Alarm>(Topic::kAlarm, alarm); }
+  bool publish(const msg::Status& status) override { return write<mpm_dds_Status>(Topic::kStatus, status); }
   bool publish(const msg::Diagnosis& diagnosis) override {
-    std::lock_guard lock(publish_mutex_);
-    const dds_entity_t w = writer(Topic::kDiagnosis);
-    if (w <= 0) return false;
-    mpm_dds_Diagnosis wire{};
-    dds_codec::to_wire(diagnosis, wire, scratch_);
-    return dds_write(w, &wire) == DDS_RETCODE_OK;
+    return write<mpm_dds_Diagnosis>(Topic::kDiagnosis, diagnosis);
   }
 
   int handle(std::chrono::milliseconds timeout) override {
@@ -228,6 +193,31 @@ class DdsTransport final : public Transport {
   dds_entity_t status_topic() { return topic(status_topic_, &mpm_dds_Status_desc, settings_.status_topic); }
   dds_entity_t diagnosis_topic() {
     return topic(diagnosis_topic_, &mpm_dds_Diagnosis_desc, settings_.diagnosis_topic);
+  }
+
+  // A reader of `topic` with `qos` (owned here), whose messages go to `slot`.
+  template <typename Handler>
+  bool subscribe(dds_entity_t topic, dds_qos_t* qos, dds_entity_t& reader, Handler& slot, Handler handler) {
+    const QosHolder holder(qos);
+    if (!add_reader(topic, holder.get(), reader)) return false;
+    slot = std::move(handler);
+    return true;
+  }
+
+  // `message` on its topic's writer. The wire struct is a view into the
+  // message and scratch_ (an alarm has no sequence, so no scratch).
+  template <typename Wire, typename Plain>
+  bool write(Topic topic, const Plain& message) {
+    std::lock_guard lock(publish_mutex_);
+    const dds_entity_t w = writer(topic);
+    if (w <= 0) return false;
+    Wire wire{};
+    if constexpr (std::is_same_v<Plain, msg::Alarm>) {
+      dds_codec::to_wire(message, wire);
+    } else {
+      dds_codec::to_wire(message, wire, scratch_);
+    }
+    return dds_write(w, &wire) == DDS_RETCODE_OK;
   }
 
   bool add_reader(dds_entity_t topic, const dds_qos_t* qos, dds_entity_t& reader) {

@@ -85,24 +85,16 @@ class FakeTransport final : public Transport {
   ~FakeTransport() override { bus_->detach(inbox_); }
 
   bool subscribe_samples(SampleHandler handler) override {
-    on_sample_ = std::move(handler);
-    bus_->with_lock([&] { inbox_->samples = true; });
-    return true;
+    return subscribe(on_sample_, std::move(handler), &FakeBus::Inbox::samples);
   }
   bool subscribe_alarms(AlarmHandler handler) override {
-    on_alarm_ = std::move(handler);
-    bus_->with_lock([&] { inbox_->alarms = true; });
-    return true;
+    return subscribe(on_alarm_, std::move(handler), &FakeBus::Inbox::alarms);
   }
   bool subscribe_status(StatusHandler handler) override {
-    on_status_ = std::move(handler);
-    bus_->with_lock([&] { inbox_->status = true; });
-    return true;
+    return subscribe(on_status_, std::move(handler), &FakeBus::Inbox::status);
   }
   bool subscribe_diagnoses(DiagnosisHandler handler) override {
-    on_diagnosis_ = std::move(handler);
-    bus_->with_lock([&] { inbox_->diagnoses = true; });
-    return true;
+    return subscribe(on_diagnosis_, std::move(handler), &FakeBus::Inbox::diagnoses);
   }
 
   bool publish(const msg::Sample& sample) override { return deliver(sample); }
@@ -122,6 +114,14 @@ class FakeTransport final : public Transport {
   std::string describe() const override { return "fake in-process bus"; }
 
  private:
+  // From now on the bus queues this kind for us (the inbox flag `wanted`).
+  template <typename Handler>
+  bool subscribe(Handler& slot, Handler handler, bool FakeBus::Inbox::*wanted) {
+    slot = std::move(handler);
+    bus_->with_lock([&] { (*inbox_).*wanted = true; });
+    return true;
+  }
+
   template <typename M>
   bool deliver(const M& message) {
     bus_->deliver(Message{message});

@@ -61,25 +61,11 @@ class LcmTransport final : public Transport {
     return subscribe(settings_.diagnosis_channel, routes_[3], &LcmTransport::receive_diagnosis);
   }
 
-  bool publish(const msg::Sample& sample) override {
-    std::lock_guard lock(publish_mutex_);
-    lcm_codec::to_wire(sample, tx_sample_);
-    return send(settings_.sample_channel, tx_sample_);
-  }
-  bool publish(const msg::Alarm& alarm) override {
-    std::lock_guard lock(publish_mutex_);
-    lcm_codec::to_wire(alarm, tx_alarm_);
-    return send(settings_.alarm_channel, tx_alarm_);
-  }
-  bool publish(const msg::Status& status) override {
-    std::lock_guard lock(publish_mutex_);
-    lcm_codec::to_wire(status, tx_status_);
-    return send(settings_.status_channel, tx_status_);
-  }
+  bool publish(const msg::Sample& sample) override { return send(settings_.sample_channel, sample, tx_sample_); }
+  bool publish(const msg::Alarm& alarm) override { return send(settings_.alarm_channel, alarm, tx_alarm_); }
+  bool publish(const msg::Status& status) override { return send(settings_.status_channel, status, tx_status_); }
   bool publish(const msg::Diagnosis& diagnosis) override {
-    std::lock_guard lock(publish_mutex_);
-    lcm_codec::to_wire(diagnosis, tx_diagnosis_);
-    return send(settings_.diagnosis_channel, tx_diagnosis_);
+    return send(settings_.diagnosis_channel, diagnosis, tx_diagnosis_);
   }
 
   // lcm's handleTimeout dispatches one message; drain what is already waiting
@@ -113,8 +99,8 @@ class LcmTransport final : public Transport {
     (r->self->*r->receive)(rbuf);
   }
 
-  bool subscribe(const std::string& channel, Route& route, Receive receive) {
-    route = Route{this, receive};
+  bool subscribe(const std::string& channel, Route& route, Receive decode) {
+    route = Route{this, decode};
     lcm_subscription_t* sub = lcm_subscribe(lcm_, channel.c_str(), &LcmTransport::dispatch, &route);
     if (sub == nullptr) return false;
     lcm_subscription_set_queue_capacity(sub, kLcmQueueCapacity);
@@ -126,8 +112,12 @@ class LcmTransport final : public Transport {
     return ::poll(&p, 1, 0) > 0 && (p.revents & POLLIN);
   }
 
-  template <typename Wire>
-  bool send(const std::string& channel, const Wire& wire) {
+  // `message` encoded through its lcm-gen struct `wire` (kept, so its
+  // arrays keep their capacity) and published on `channel`.
+  template <typename Plain, typename Wire>
+  bool send(const std::string& channel, const Plain& message, Wire& wire) {
+    std::lock_guard lock(publish_mutex_);
+    lcm_codec::to_wire(message, wire);
     const int size = wire.getEncodedSize();
     if (size < 0) return false;
     tx_buffer_.resize(static_cast<std::size_t>(size));

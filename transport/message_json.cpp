@@ -73,7 +73,8 @@ class JsonObject {
 
   void quote(const std::string& s) {
     text_ += '"';
-    for (const unsigned char c : s) {
+    for (const char ch : s) {
+      const auto c = static_cast<unsigned char>(ch);  // bytes >= 0x80 (UTF-8) pass as they are
       switch (c) {
         case '"': text_ += "\\\""; break;
         case '\\': text_ += "\\\\"; break;

@@ -60,6 +60,16 @@ bool notify(const std::string& socket_path, const std::string& text) {
 
 std::vector<std::string> sh(const std::string& script) { return {"/bin/sh", "-c", script}; }
 
+// A temporary folder with a notify socket bound in it, as systemd gives one
+// (ok() makes both; `why` says what failed).
+struct NotifyDir {
+  TempDir dir;
+  NotifySocket sock;
+  std::string path = dir.file("notify.sock");
+  std::string why;
+  bool ok() { return dir.ok(why) && sock.bind(path, why); }
+};
+
 TEST(TempDir, MadeUnderTmpdirAndRemovedWithItsContents) {
   std::string kept;
   {
@@ -94,16 +104,14 @@ TEST(ChildEnvironment, OurNotifySocketAndNoWatchdog) {
 }
 
 TEST(ChildProcess, NeverReadyAndIgnoringSigtermIsKilledAndReaped) {
-  TempDir dir;
-  NotifySocket sock;
-  std::string why;
-  ASSERT_TRUE(dir.ok(why)) << why;
-  ASSERT_TRUE(sock.bind(dir.file("notify.sock"), why)) << why;
+  NotifyDir n;
+  ASSERT_TRUE(n.ok()) << n.why;
+  auto& [dir, sock, path, why] = n;
   pid_t pid = 0;
   {
     ChildProcess child(milliseconds(200));
     ASSERT_TRUE(child.start(sh("trap '' TERM; echo armed; while :; do sleep 0.05; done"),
-                            environment_with_notify_socket(dir.file("notify.sock")), dir.file("child.log"), why))
+                            environment_with_notify_socket(path), dir.file("child.log"), why))
         << why;
     pid = child.pid();
     ASSERT_TRUE(wait_for_log_line(dir.file("child.log"), "armed")) << "the child never ran its trap";
@@ -134,12 +142,9 @@ TEST(ChildProcess, OneThatHonoursSigtermIsStoppedByIt) {
 }
 
 TEST(ChildProcess, ExitingBeforeReadyIsReportedWithItsCodeAndLastLogLine) {
-  TempDir dir;
-  NotifySocket sock;
-  std::string why;
-  ASSERT_TRUE(dir.ok(why)) << why;
-  const std::string path = dir.file("notify.sock");
-  ASSERT_TRUE(sock.bind(path, why)) << why;
+  NotifyDir n;
+  ASSERT_TRUE(n.ok()) << n.why;
+  auto& [dir, sock, path, why] = n;
   ::setenv("WATCHDOG_USEC", "1000000", 1);
   const auto env = environment_with_notify_socket(path);
   ::unsetenv("WATCHDOG_USEC");
@@ -198,12 +203,9 @@ TEST(ChildProcess, ForTestsSeparateOutputsAddedEnvironmentAndExitCodes) {
 }
 
 TEST(NotifySocket, ReadyIsFoundAmongOtherNotifications) {
-  TempDir dir;
-  NotifySocket sock;
-  std::string why;
-  ASSERT_TRUE(dir.ok(why)) << why;
-  const std::string path = dir.file("notify.sock");
-  ASSERT_TRUE(sock.bind(path, why)) << why;
+  NotifyDir n;
+  ASSERT_TRUE(n.ok()) << n.why;
+  auto& [dir, sock, path, why] = n;
   ASSERT_TRUE(notify(path, "STATUS=starting"));
   EXPECT_FALSE(sock.receive("READY=1", std::chrono::seconds(30)));
 

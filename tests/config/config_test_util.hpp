@@ -24,6 +24,18 @@ inline std::filesystem::path temp_dir(const std::string& tag) {
   return dir;
 }
 
+// The message of the ConfigError that `load()` throws, or "(no ConfigError
+// thrown)" (any other exception escapes and fails the test).
+template <class Load>
+std::string config_error(Load&& load) {
+  try {
+    load();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "(no ConfigError thrown)";
+}
+
 inline void write_text(const std::filesystem::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
   out << text;

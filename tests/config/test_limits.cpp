@@ -24,14 +24,7 @@ namespace {
 using testing_util::temp_dir;
 using testing_util::write_text;
 
-std::string error_of(auto&& load) {
-  try {
-    load();
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+std::string error_of(auto&& load) { return testing_util::config_error(load); }
 
 std::string names(const char* prefix, std::size_t n) {
   std::string out = "[";
@@ -166,7 +159,7 @@ TEST(StrictModes, PrivateFilesAreAccepted) {
 }
 
 TEST(StrictModes, GroupOrWorldWritableConfigIsRefused) {
-  for (const mode_t mode : {0666, 0620, 0602}) {
+  for (const mode_t mode : {mode_t{0666}, mode_t{0620}, mode_t{0602}}) {
     const DaemonFiles f = daemon_files("strict_cfg");
     ::chmod(f.config.c_str(), mode);
     const std::string e = error_of([&] { load_daemon_config(f.config.string()); });

@@ -45,34 +45,32 @@ TEST(MalformedPlant, EveryTruncationLoadsOrThrowsConfigError) {
   }
 }
 
-TEST(MalformedPlant, RandomByteEditsLoadOrThrowConfigError) {
-  const std::string full = plant_text();
-  const std::string alphabet = "0123456789-.:,[]{}#- \n\tabxyz\"'e";
-  std::mt19937 rng(42);
-  for (int trial = 0; trial < 1500; ++trial) {
+// `trials` copies of `full` with one to three bytes replaced by characters
+// of `alphabet`: each loads or throws ConfigError.
+template <typename Parse>
+void expect_random_edits_load_or_config_error(const std::string& full, const std::string& alphabet,
+                                              unsigned seed, int trials, Parse parse) {
+  std::mt19937 rng(seed);
+  for (int trial = 0; trial < trials; ++trial) {
     std::string text = full;
     for (int edits = 1 + trial % 3; edits > 0; --edits) {
       const std::size_t at = rng() % text.size();
       text[at] = alphabet[rng() % alphabet.size()];
     }
-    const std::string result = outcome([&] { parse_plant(text, "wb.yaml"); });
+    const std::string result = outcome([&] { parse(text); });
     ASSERT_TRUE(result == "ok" || result == "config error") << result << "\n" << text;
   }
 }
 
+TEST(MalformedPlant, RandomByteEditsLoadOrThrowConfigError) {
+  expect_random_edits_load_or_config_error(plant_text(), "0123456789-.:,[]{}#- \n\tabxyz\"'e", 42, 1500,
+                                           [](const std::string& text) { parse_plant(text, "wb.yaml"); });
+}
+
 TEST(MalformedRecording, RandomByteEditsLoadOrThrowConfigError) {
-  const std::string full = "t,u1,y1,sim_y1\n0,1.5,2,\n1,-3e2,nan,4\n2,0.25,1e-300,5\n";
-  const std::string alphabet = "0123456789-+.,eE\r\n nNaAiI";
-  std::mt19937 rng(7);
-  for (int trial = 0; trial < 3000; ++trial) {
-    std::string text = full;
-    for (int edits = 1 + trial % 3; edits > 0; --edits) {
-      const std::size_t at = rng() % text.size();
-      text[at] = alphabet[rng() % alphabet.size()];
-    }
-    const std::string result = outcome([&] { parse_recording(text, "r.csv"); });
-    ASSERT_TRUE(result == "ok" || result == "config error") << result << "\n" << text;
-  }
+  expect_random_edits_load_or_config_error("t,u1,y1,sim_y1\n0,1.5,2,\n1,-3e2,nan,4\n2,0.25,1e-300,5\n",
+                                           "0123456789-+.,eE\r\n nNaAiI", 7, 3000,
+                                           [](const std::string& text) { parse_recording(text, "r.csv"); });
 }
 
 }  // namespace

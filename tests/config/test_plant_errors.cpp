@@ -43,12 +43,7 @@ int marked_line(const std::string& yaml) {
 }
 
 std::string thrown_message(const std::string& yaml, const std::string& source) {
-  try {
-    parse_plant(yaml, source);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "(no ConfigError thrown)";
+  return testing_util::config_error([&] { parse_plant(yaml, source); });
 }
 
 std::vector<ErrorCase> error_cases() {
@@ -180,29 +175,21 @@ TEST_P(PlantErrors, MessageNamesFileLineKeyAndExpectation) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, PlantErrors, ::testing::ValuesIn(error_cases()),
-                         [](const auto& info) { return info.param.name; });
+                         [](const auto& test) { return test.param.name; });
 
 TEST(PlantErrorsFromFiles, MessageNamesThePathGiven) {
   const auto path = testing_util::temp_dir("plant_errors") / "typo.yaml";
   testing_util::write_text(path, kHeader + "model:\n  - output: y1\n    input: u1\n    num: []\n");
-  try {
-    load_plant(path.string());
-    FAIL() << "no ConfigError";
-  } catch (const ConfigError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind(path.string() + ":8:", 0), 0u) << e.what();
-    EXPECT_NE(std::string(e.what()).find("model[0].num"), std::string::npos) << e.what();
-  }
+  const std::string e = testing_util::config_error([&] { load_plant(path.string()); });
+  EXPECT_EQ(e.rfind(path.string() + ":8:", 0), 0u) << e;
+  EXPECT_NE(e.find("model[0].num"), std::string::npos) << e;
 }
 
 TEST(PlantErrorsFromFiles, MissingFileIsNamed) {
   const auto path = testing_util::temp_dir("plant_errors") / "does-not-exist.yaml";
-  try {
-    load_plant(path.string());
-    FAIL() << "no ConfigError";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("No such file"), std::string::npos) << e.what();
-  }
+  const std::string e = testing_util::config_error([&] { load_plant(path.string()); });
+  EXPECT_NE(e.find(path.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("No such file"), std::string::npos) << e;
 }
 
 }  // namespace

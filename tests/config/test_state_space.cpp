@@ -12,17 +12,14 @@
 #include <gtest/gtest.h>
 
 #include "config/plant_loader.hpp"
+#include "config_test_util.hpp"
 #include "core/transfer_function.hpp"
+#include "support/tf_step.hpp"
 
 namespace mpm::config {
 namespace {
 
-std::vector<double> tf_step(const DiscreteTf& tf, int steps) {
-  DiscreteFilter f(tf);
-  std::vector<double> y;
-  for (int k = 0; k < steps; ++k) y.push_back(f.step(1.0));
-  return y;
-}
+using test::tf_step;
 
 const ChannelModel* find(const PlantModel& p, std::size_t j, std::size_t i) { return p.channel(j, i); }
 
@@ -60,7 +57,8 @@ TEST(StateSpace, DiscreteStepResponsesEqualTheRecursion) {
       const ChannelModel* ch = find(p, j, i);
       ASSERT_NE(ch, nullptr) << j << i;
       const std::vector<double> s = tf_step(ch->tf, 60);
-      for (int k = 0; k < 60; ++k) EXPECT_NEAR(s[k], y[k][static_cast<Eigen::Index>(j)], 1e-10) << j << i << " k " << k;
+      for (std::size_t k = 0; k < 60; ++k)
+        EXPECT_NEAR(s[k], y[k][static_cast<Eigen::Index>(j)], 1e-10) << j << i << " k " << k;
     }
   }
 }
@@ -99,7 +97,8 @@ state_space:
       const std::vector<double> s = tf_step(ch->tf, 40);
       // A step applied at sample 0 reaches the sampled output one sample later.
       EXPECT_NEAR(s[0], 0.0, 1e-12);
-      for (int k = 1; k < 40; ++k) EXPECT_NEAR(s[k], y[k][static_cast<Eigen::Index>(j)], 1e-9) << j << i << " k " << k;
+      for (std::size_t k = 1; k < 40; ++k)
+        EXPECT_NEAR(s[k], y[k][static_cast<Eigen::Index>(j)], 1e-9) << j << i << " k " << k;
     }
   }
 }
@@ -114,7 +113,7 @@ TEST(StateSpace, TheQuadTankAsAStateSpaceHasTheTransferFunctionFilesChannels) {
     // Shared roots cancelled: the first-order channels stay first order.
     ASSERT_EQ(got->tf.den.size(), want.tf.den.size()) << want.output << want.input;
     const std::vector<double> a = tf_step(got->tf, 200), b = tf_step(want.tf, 200);
-    for (int k = 0; k < 200; ++k) EXPECT_NEAR(a[k], b[k], 1e-8 * (1 + std::abs(b[k]))) << k;
+    for (std::size_t k = 0; k < 200; ++k) EXPECT_NEAR(a[k], b[k], 1e-8 * (1 + std::abs(b[k]))) << k;
   }
 }
 
@@ -157,35 +156,29 @@ state_space:
   }
 }
 
-std::string load_error(const std::string& yaml) {
-  try {
-    (void)parse_plant(yaml, "bad.yaml");
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(StateSpace, ShapeAndStabilityErrorsAreLocated) {
   const std::string head = "plant: x\nsample_time: 1\ninputs: [u1]\noutputs: [y1]\n";
-  EXPECT_NE(load_error(head + "state_space:\n  discrete: true\n  A: [[0.5, 0]]\n  B: [[1]]\n  C: [[1]]\n")
-                .find("bad.yaml:7:7: state_space.A[0]: expected 1 numbers in each row of a 1 x 1 matrix, got 2"),
-            std::string::npos);
-  EXPECT_NE(load_error(head + "state_space:\n  discrete: true\n  A: [[0.5]]\n  B: [[1, 2]]\n  C: [[1]]\n")
-                .find("state_space.B[0]: expected 1 numbers in each row"),
-            std::string::npos);
-  EXPECT_NE(load_error(head + "state_space:\n  discrete: yes\n  A: [[0.5]]\n  B: [[1]]\n  C: [[1]]\n")
-                .find("state_space.discrete: expected true"),
-            std::string::npos);
-  EXPECT_NE(load_error(head + "state_space:\n  discrete: true\n  A: [[1.5]]\n  B: [[1]]\n  C: [[1]]\n")
-                .find("state_space.A: expected a stable or integrating model"),
-            std::string::npos);
-  EXPECT_NE(load_error(head + "model: []\nstate_space:\n  discrete: true\n  A: [[0.5]]\n  B: [[1]]\n  C: [[1]]\n")
-                .find("give the model as `model:` channels or as `state_space:`, not both"),
-            std::string::npos);
-  EXPECT_NE(load_error(head + "state_space:\n  discrete: true\n  A: [[0.5]]\n  B: [[1]]\n  C: [[1]]\n  G: [[1]]\n")
-                .find("state_space.noise: missing: G needs noise"),
-            std::string::npos);
+  struct Case {
+    std::string yaml;  // after `head`
+    std::string error;  // a part of the message
+  };
+  const Case cases[] = {
+      {"state_space:\n  discrete: true\n  A: [[0.5, 0]]\n  B: [[1]]\n  C: [[1]]\n",
+       "bad.yaml:7:7: state_space.A[0]: expected 1 numbers in each row of a 1 x 1 matrix, got 2"},
+      {"state_space:\n  discrete: true\n  A: [[0.5]]\n  B: [[1, 2]]\n  C: [[1]]\n",
+       "state_space.B[0]: expected 1 numbers in each row"},
+      {"state_space:\n  discrete: yes\n  A: [[0.5]]\n  B: [[1]]\n  C: [[1]]\n", "state_space.discrete: expected true"},
+      {"state_space:\n  discrete: true\n  A: [[1.5]]\n  B: [[1]]\n  C: [[1]]\n",
+       "state_space.A: expected a stable or integrating model"},
+      {"model: []\nstate_space:\n  discrete: true\n  A: [[0.5]]\n  B: [[1]]\n  C: [[1]]\n",
+       "give the model as `model:` channels or as `state_space:`, not both"},
+      {"state_space:\n  discrete: true\n  A: [[0.5]]\n  B: [[1]]\n  C: [[1]]\n  G: [[1]]\n",
+       "state_space.noise: missing: G needs noise"},
+  };
+  for (const Case& c : cases) {
+    const std::string e = testing_util::config_error([&] { (void)parse_plant(head + c.yaml, "bad.yaml"); });
+    EXPECT_NE(e.find(c.error), std::string::npos) << c.yaml << " -> " << e;
+  }
 }
 
 }  // namespace

@@ -24,7 +24,7 @@ using mpm::DiscreteTf;
 struct Channel {
   double gain = 0.0;
   double pole = 0.0;
-  int delay = 1;
+  std::size_t delay = 1;
 };
 
 using Plant = std::vector<std::vector<Channel>>;  // [output][input]
@@ -39,7 +39,7 @@ std::vector<double> filter_channel(const Channel& c, const std::vector<double>& 
   std::vector<double> y(u.size(), 0.0);
   for (std::size_t k = 0; k < u.size(); ++k) {
     const double previous = k > 0 ? y[k - 1] : 0.0;
-    const double input = k >= static_cast<std::size_t>(c.delay) ? u[k - c.delay] : 0.0;
+    const double input = k >= c.delay ? u[k - c.delay] : 0.0;
     y[k] = c.pole * previous + c.gain * input;
   }
   return y;
@@ -64,6 +64,11 @@ DiscreteTf noise_model(double pole, double num0 = 1.0) {
   return n;
 }
 
+// m(r, c) for the std::size_t loop counters of these tests.
+double& at(MatrixXd& m, std::size_t r, std::size_t c) {
+  return m(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c));
+}
+
 struct Data {
   MatrixXd u;
   MatrixXd residual;
@@ -80,19 +85,19 @@ Data open_loop(const Plant& plant, const Plant& model, unsigned seed, double noi
   d.u.resize(kSamples, 2);
   d.residual.resize(kSamples, 2);
   std::vector<std::vector<double>> u;
-  for (int i = 0; i < 2; ++i) u.push_back(ar1(rng, kSamples, 0.8, 1.0));
-  for (int j = 0; j < 2; ++j) {
+  for (std::size_t i = 0; i < 2; ++i) u.push_back(ar1(rng, kSamples, 0.8, 1.0));
+  for (std::size_t j = 0; j < 2; ++j) {
     std::vector<double> r = ar1(rng, kSamples, kNoisePoles[j], noise_num0);
-    for (int i = 0; i < 2; ++i) {
+    for (std::size_t i = 0; i < 2; ++i) {
       const std::vector<double> yp = filter_channel(plant[j][i], u[i]);
       const std::vector<double> ym = filter_channel(model[j][i], u[i]);
       for (std::size_t k = 0; k < kSamples; ++k) r[k] += yp[k] - ym[k];
     }
-    for (std::size_t k = 0; k < kSamples; ++k) d.residual(k, j) = r[k];
+    for (std::size_t k = 0; k < kSamples; ++k) at(d.residual, k, j) = r[k];
     d.noise.push_back(noise_model(kNoisePoles[j], noise_num0));
   }
-  for (int i = 0; i < 2; ++i) {
-    for (std::size_t k = 0; k < kSamples; ++k) d.u(k, i) = u[i][k];
+  for (std::size_t i = 0; i < 2; ++i) {
+    for (std::size_t k = 0; k < kSamples; ++k) at(d.u, k, i) = u[i][k];
   }
   return d;
 }
@@ -112,13 +117,13 @@ Data closed_loop(const Plant& plant, const Plant& model, unsigned seed) {
   d.u.resize(kSamples, 2);
   d.residual.resize(kSamples, 2);
   for (std::size_t k = 0; k < kSamples; ++k) {
-    for (int i = 0; i < 2; ++i) u_hist[i][k] = -k_gain[i] * y_prev[i] + white(rng);
-    for (int j = 0; j < 2; ++j) {
+    for (std::size_t i = 0; i < 2; ++i) u_hist[i][k] = -k_gain[i] * y_prev[i] + white(rng);
+    for (std::size_t j = 0; j < 2; ++j) {
       noise_state[j] = kNoisePoles[j] * noise_state[j] + white(rng);
       double y = noise_state[j], ym = 0.0;
-      for (int i = 0; i < 2; ++i) {
+      for (std::size_t i = 0; i < 2; ++i) {
         const auto step = [&](const Channel& c, double& state) {
-          const double in = k >= static_cast<std::size_t>(c.delay) ? u_hist[i][k - c.delay] : 0.0;
+          const double in = k >= c.delay ? u_hist[i][k - c.delay] : 0.0;
           state = c.pole * state + c.gain * in;
           return state;
         };
@@ -126,9 +131,9 @@ Data closed_loop(const Plant& plant, const Plant& model, unsigned seed) {
         ym += step(model[j][i], y_model_state[2 * j + i]);
       }
       y_prev[j] = y;
-      d.residual(k, j) = y - ym;
+      at(d.residual, k, j) = y - ym;
     }
-    for (int i = 0; i < 2; ++i) d.u(k, i) = u_hist[i][k];
+    for (std::size_t i = 0; i < 2; ++i) at(d.u, k, i) = u_hist[i][k];
   }
   d.noise = {noise_model(kNoisePoles[0]), noise_model(kNoisePoles[1])};
   return d;

@@ -34,6 +34,13 @@ struct PlantedRun {
     noise.emplace_back(DiscreteTf{{1}, {1, -0.8}, 0});
     noise.emplace_back(DiscreteTf{{1}, {1, -0.9}, 0});
   }
+  // n samples of this run into the monitor.
+  void feed(GrangerMonitor& m, int n_samples) {
+    for (int k = 0; k < n_samples; ++k) {
+      step();
+      m.update(u, d);
+    }
+  }
   void step() {
     u[0] = u1_shape.step(n(rng));
     const double own = n(rng);
@@ -76,10 +83,7 @@ TEST(GrangerMonitor, LocatesThePlantedChannelDespiteCorrelatedInputs) {
   PlantedRun run(2);
   run.dg[1][0] = DiscreteFilter(DiscreteTf{{0.3}, {1, -0.8}, 2});  // mismatch u1 -> y2 only
   GrangerMonitor m(2, 2, test_settings(), wood_berry_noise(5));
-  for (int k = 0; k < 5000; ++k) {
-    run.step();
-    m.update(run.u, run.d);
-  }
+  run.feed(m, 5000);
   EXPECT_TRUE(m.channel(1, 0).alarm);
   EXPECT_FALSE(m.channel(1, 1).alarm);
   EXPECT_FALSE(m.channel(0, 0).alarm);
@@ -106,10 +110,7 @@ TEST(GrangerMonitor, ConditionalTestIsCalibratedUnderNoCausality) {
     PlantedRun run(seed);
     run.independent = true;
     GrangerMonitor m(2, 2, s);
-    for (int k = 0; k < 1500; ++k) {
-      run.step();
-      m.update(run.u, run.d);
-    }
+    run.feed(m, 1500);
     for (std::size_t j = 0; j < 2; ++j)
       for (std::size_t i = 0; i < 2; ++i) {
         above += m.channel(j, i).lr_conditional > m.raise_threshold();
@@ -152,10 +153,7 @@ TEST(GrangerMonitor, AlarmClearsWhenTheMismatchGoes) {
   MonitorSettings s = test_settings();
   s.forgetting = 0.99;  // short memory so the verdict follows the plant
   GrangerMonitor m(2, 2, s, wood_berry_noise(5));
-  for (int k = 0; k < 3000; ++k) {
-    run.step();
-    m.update(run.u, run.d);
-  }
+  run.feed(m, 3000);
   ASSERT_TRUE(m.channel(1, 0).alarm);
   run.dg[1][0].reset();
   // The output clears when every detector window has forgotten the
@@ -268,10 +266,7 @@ TEST(GrangerMonitor, OneOutlierIsSkippedCountedAndForgotten) {
   // "diverging" for thousands of samples: it is now skipped and counted.
   PlantedRun run(6);
   GrangerMonitor m(2, 2, test_settings(), wood_berry_noise(5));
-  for (int k = 0; k < 3000; ++k) {
-    run.step();
-    m.update(run.u, run.d);
-  }
+  run.feed(m, 3000);
   const double sigma_before = m.loop(0).sigma1;
   run.step();
   double d[2] = {run.d[0] + 1e6, run.d[1]};
@@ -294,10 +289,7 @@ TEST(GrangerMonitor, HugeValuesLeaveNoNaNBehind) {
   // its prior, counted, and its statistics are finite again.
   PlantedRun run(7);
   GrangerMonitor m(2, 2, test_settings(), wood_berry_noise(5));
-  for (int k = 0; k < 2000; ++k) {
-    run.step();
-    m.update(run.u, run.d);
-  }
+  run.feed(m, 2000);
   run.step();
   double d[2] = {run.d[0], 1e100};
   m.update(run.u, d);
@@ -306,10 +298,7 @@ TEST(GrangerMonitor, HugeValuesLeaveNoNaNBehind) {
     double big[2] = {run.d[0], 1e300};
     m.update(run.u, big);
   }
-  for (int k = 0; k < 3000; ++k) {
-    run.step();
-    m.update(run.u, run.d);
-  }
+  run.feed(m, 3000);
   EXPECT_GE(m.counters().outliers, 1u);
   EXPECT_GE(m.counters().resets, 1u);
   for (std::size_t j = 0; j < 2; ++j) {
@@ -325,10 +314,7 @@ TEST(GrangerMonitor, UpdateAllocatesNothing) {
   GrangerMonitor m(2, 2, s, wood_berry_noise(10));
   PlantedRun run(6);
   run.dg[1][0] = DiscreteFilter(DiscreteTf{{0.3}, {1, -0.8}, 2});
-  for (int k = 0; k < 100; ++k) {  // warm the lags (not counted)
-    run.step();
-    m.update(run.u, run.d);
-  }
+  run.feed(m, 100);  // warm the lags (not counted)
   std::vector<double> us, ds;  // pre-generated so only update() is measured
   for (int k = 0; k < 100'000; ++k) {
     run.step();

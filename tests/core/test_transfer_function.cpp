@@ -6,17 +6,12 @@
 
 #include "core/noise_filter.hpp"
 #include "core/transfer_function.hpp"
+#include "support/tf_step.hpp"
 
 namespace mpm {
 namespace {
 
-// Step response of a discrete channel, samples 0..n-1 (unit step at k = 0).
-std::vector<double> step_response(const DiscreteTf& tf, int n) {
-  DiscreteFilter f(tf);
-  std::vector<double> y;
-  for (int k = 0; k < n; ++k) y.push_back(f.step(1.0));
-  return y;
-}
+using test::tf_step;
 
 TEST(Zoh, WoodBerryChannelsMatchPaper) {
   struct Case { ContinuousTf g; double b; double a; int delay; };
@@ -40,7 +35,7 @@ TEST(Zoh, FractionalDeadTimeMatchesExactStepResponse) {
   // K e^{-tau s}/(T s + 1): y(t) = K (1 - e^{-(t - tau)/T}) for t > tau.
   const double K = 2.0, T = 7.0, tau = 2.6, ts = 1.0;
   const DiscreteTf d = discretize_zoh({{K}, {T, 1}, tau}, ts);
-  const auto y = step_response(d, 40);
+  const auto y = tf_step(d, 40);
   for (int k = 0; k < 40; ++k) {
     const double t = k * ts;
     const double exact = t > tau ? K * (1 - std::exp(-(t - tau) / T)) : 0.0;
@@ -53,7 +48,7 @@ TEST(Zoh, IntegratingSecondOrderMatchesExactStepResponse) {
   const DiscreteTf d = discretize_zoh({{1}, {1, 1, 0}, 0.0}, 0.5);
   EXPECT_TRUE(d.has_integrator());
   EXPECT_FALSE(d.is_stable());
-  const auto y = step_response(d, 30);
+  const auto y = tf_step(d, 30);
   for (int k = 0; k < 30; ++k) {
     const double t = 0.5 * k;
     EXPECT_NEAR(y[static_cast<std::size_t>(k)], t - 1 + std::exp(-t), 1e-9) << "k=" << k;
@@ -63,7 +58,7 @@ TEST(Zoh, IntegratingSecondOrderMatchesExactStepResponse) {
 TEST(Zoh, ProperChannelWithFeedthroughAndZero) {
   // (s + 2)/(s + 1) = 1 + 1/(s + 1): y(t) = 2 - e^{-t} for a step.
   const DiscreteTf d = discretize_zoh({{1, 2}, {1, 1}, 0.0}, 0.2);
-  const auto y = step_response(d, 20);
+  const auto y = tf_step(d, 20);
   for (int k = 0; k < 20; ++k) EXPECT_NEAR(y[static_cast<std::size_t>(k)], 2 - std::exp(-0.2 * k), 1e-10);
 }
 
@@ -77,7 +72,7 @@ TEST(Zoh, RejectsImproperAndInvalid) {
 TEST(DiscreteFilter, DelayAndDcGain) {
   DiscreteTf tf{{0.5}, {1, -0.5}, 3};
   EXPECT_DOUBLE_EQ(tf.dc_gain(), 1.0);
-  const auto y = step_response(tf, 60);
+  const auto y = tf_step(tf, 60);
   EXPECT_EQ(y[0], 0.0);
   EXPECT_EQ(y[2], 0.0);
   EXPECT_DOUBLE_EQ(y[3], 0.5);

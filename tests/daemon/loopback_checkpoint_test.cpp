@@ -15,42 +15,10 @@
 #include "daemon/mpmd/checkpoint.hpp"
 #include "daemon/mpmd/setup.hpp"
 #include "loopback_fixture.hpp"
+#include "status_compare.hpp"
 
 namespace mpm::test {
 namespace {
-
-double rel(double a, double b) {
-  if ((std::isnan(a) && std::isnan(b)) || a == b) return 0.0;
-  return std::abs(a - b) / std::max(std::abs(a), std::abs(b));
-}
-
-// Largest relative difference of the statistics; counters and flags must be equal.
-double compare(const msg::Status& a, const msg::Status& b) {
-  EXPECT_EQ(a.samples_seen, b.samples_seen);
-  EXPECT_EQ(a.samples_used, b.samples_used);
-  EXPECT_EQ(a.alarms_raised, b.alarms_raised);
-  EXPECT_EQ(a.ready, b.ready);
-  double worst = rel(a.effective_samples, b.effective_samples);
-  if (a.channels.size() != b.channels.size() || a.loops.size() != b.loops.size()) {
-    ADD_FAILURE() << "different shapes";
-    return 1.0;
-  }
-  for (std::size_t c = 0; c < a.channels.size(); ++c) {
-    const auto& x = a.channels[c];
-    const auto& y = b.channels[c];
-    EXPECT_EQ(x.alarm, y.alarm);
-    for (const auto& [p, q] : {std::pair{x.f_pairwise, y.f_pairwise}, {x.f_conditional, y.f_conditional},
-                               {x.lr, y.lr}, {x.gamma, y.gamma}}) {
-      worst = std::max(worst, rel(p, q));
-    }
-  }
-  for (std::size_t j = 0; j < a.loops.size(); ++j) {
-    EXPECT_EQ(a.loops[j].alarm, b.loops[j].alarm);
-    worst = std::max({worst, rel(a.loops[j].residual_variance, b.loops[j].residual_variance),
-                      rel(a.loops[j].sigma1, b.loops[j].sigma1), rel(a.loops[j].sigma_full, b.loops[j].sigma_full)});
-  }
-  return worst;
-}
 
 // The monitor mpmd builds from `config`, fed `samples[0, n)` in this process.
 msg::Status reference(const std::string& config, const std::vector<msg::Sample>& samples, std::size_t n) {
@@ -154,7 +122,7 @@ TEST_P(CheckpointTest, SigkillMidRunResumesTheStatisticsAndTheAlarm) {
       << second->stderr_text();
   const msg::Status resumed = *obs.status("wb");
   EXPECT_EQ(static_cast<std::uint64_t>(resumed.samples_seen), resumed_at);
-  const double at_resume = compare(resumed, reference(config, sent, resumed_at));
+  const double at_resume = compare_status(resumed, reference(config, sent, resumed_at));
   EXPECT_LE(at_resume, 1e-12);
   EXPECT_EQ(resumed.alarms_raised, 1);
   EXPECT_EQ(count_lines(second->stderr_text(), "resumed from checkpoint"), 1) << second->stderr_text();
@@ -177,7 +145,7 @@ TEST_P(CheckpointTest, SigkillMidRunResumesTheStatisticsAndTheAlarm) {
   ASSERT_TRUE(sync(obs, c));
   ASSERT_TRUE(publish(*t, obs, c, 300, sent));
   const msg::Status end = *obs.status("wb");
-  const double at_end = compare(end, reference(config, sent, sent.size()));
+  const double at_end = compare_status(end, reference(config, sent, sent.size()));
   EXPECT_LE(at_end, 1e-12);
   std::printf("SIGKILL after %zu samples, checkpoint at %llu: largest relative difference %.3g at resume, "
               "%.3g after %zu samples\n",

@@ -54,14 +54,16 @@ class WoodBerryStream {
   }
 
  private:
-  static constexpr int kHistory = 16;
-  double past(int input, int delay) const { return hist_[input][(head_ + kHistory - delay) % kHistory]; }
+  static constexpr std::size_t kHistory = 16;
+  double past(std::size_t input, std::size_t delay) const {
+    return hist_[input][(head_ + kHistory - delay) % kHistory];
+  }
 
   std::mt19937_64 rng_;
   double input_std_;
   double g21_factor_ = 1.0;
   std::array<std::array<double, kHistory>, 2> hist_{};
-  int head_ = 0;
+  std::size_t head_ = 0;
   double x11_ = 0, x12_ = 0, x21_ = 0, x22_ = 0, n1_ = 0, n2_ = 0;
 };
 

@@ -2,8 +2,6 @@
 // or a ConfigError naming the source; then bound to a small plant. The same
 // bytes read by the streaming reader (CsvRowReader, from a scratch file)
 // must give the same values or the same error.
-#include <unistd.h>
-
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -13,20 +11,12 @@
 
 #include "config/csv_stream.hpp"
 #include "config/plant_loader.hpp"
+#include "tests/fuzz/fuzz_support.hpp"
 
 namespace {
-const mpm::PlantModel& plant() {
-  static const mpm::PlantModel p = mpm::config::parse_plant(
-      "plant: f\nsample_time: 1\ninputs: [u1, u2]\noutputs: [y1]\nmodel:\n"
-      "  - {output: y1, input: u1, num: [0.5], den: [1, -0.5], delay: 1}\n",
-      "plant.yaml");
-  return p;
-}
-
-const std::string& scratch() {
-  static const std::string path = "/tmp/mpm_fuzz_csv_" + std::to_string(::getpid()) + ".csv";
-  return path;
-}
+// Made at first use, once per process.
+const mpm::PlantModel& plant() { static const mpm::PlantModel p = mpm::fuzz::small_plant("[y1]"); return p; }
+const std::string& scratch() { static const std::string path = mpm::fuzz::scratch_path("csv", ".csv"); return path; }
 
 bool same(double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; }
 }  // namespace

@@ -4,8 +4,6 @@
 // character (nothing from the file is echoed raw). liblcm's reader sees a
 // frame only after its lengths were checked against the file, so a lying
 // length must never reach its allocation.
-#include <unistd.h>
-
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -13,20 +11,12 @@
 #include <string>
 
 #include "daemon/lcm_log_reader.hpp"
+#include "tests/fuzz/fuzz_support.hpp"
 
 namespace {
-const mpm::PlantModel& plant() {
-  static const mpm::PlantModel p = mpm::config::parse_plant(
-      "plant: f\nsample_time: 1\ninputs: [u1, u2]\noutputs: [y1, y2]\nmodel:\n"
-      "  - {output: y1, input: u1, num: [0.5], den: [1, -0.5], delay: 1}\n",
-      "plant.yaml");
-  return p;
-}
-
-const std::string& scratch() {
-  static const std::string path = "/tmp/mpm_fuzz_lcm_log_" + std::to_string(::getpid()) + ".lcmlog";
-  return path;
-}
+// Made at first use, once per process.
+const mpm::PlantModel& plant() { static const mpm::PlantModel p = mpm::fuzz::small_plant("[y1, y2]"); return p; }
+const std::string& scratch() { static const std::string p = mpm::fuzz::scratch_path("lcm_log", ".lcmlog"); return p; }
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

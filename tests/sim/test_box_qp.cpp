@@ -47,32 +47,32 @@ Eigen::VectorXd enumerate(const Problem& p) {
   for (int i = 0; i < n; ++i) combos *= 3;
   for (int c = 0; c < combos; ++c) {
     Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
-    std::vector<int> state(n), free;
-    for (int i = 0, code = c; i < n; ++i, code /= 3) state[i] = code % 3 - 1;
+    Eigen::VectorXi state(n), free(n);  // free(0 .. k-1): the free variables
+    for (int i = 0, code = c; i < n; ++i, code /= 3) state(i) = code % 3 - 1;
     bool possible = true;
+    int k = 0;
     for (int i = 0; i < n; ++i) {
-      if (state[i] == 0) free.push_back(i);
-      else v(i) = state[i] < 0 ? p.lo(i) : p.hi(i);
+      if (state(i) == 0) free(k++) = i;
+      else v(i) = state(i) < 0 ? p.lo(i) : p.hi(i);
       if (!std::isfinite(v(i))) possible = false;
     }
     if (!possible) continue;
-    const int k = static_cast<int>(free.size());
     Eigen::MatrixXd hf(k, k);
     Eigen::VectorXd rhs(k);
     for (int a = 0; a < k; ++a) {
-      rhs(a) = -p.g(free[a]);
+      rhs(a) = -p.g(free(a));
       for (int i = 0; i < n; ++i)
-        if (state[i] != 0) rhs(a) -= p.h(free[a], i) * v(i);
-      for (int b = 0; b < k; ++b) hf(a, b) = p.h(free[a], free[b]);
+        if (state(i) != 0) rhs(a) -= p.h(free(a), i) * v(i);
+      for (int b = 0; b < k; ++b) hf(a, b) = p.h(free(a), free(b));
     }
     const Eigen::VectorXd vf = hf.ldlt().solve(rhs);
-    for (int a = 0; a < k; ++a) v(free[a]) = vf(a);
+    for (int a = 0; a < k; ++a) v(free(a)) = vf(a);
     const Eigen::VectorXd grad = p.h * v + p.g;
     bool kkt = true;
     for (int i = 0; i < n; ++i) {
-      if (state[i] == 0) kkt = kkt && v(i) >= p.lo(i) - 1e-12 && v(i) <= p.hi(i) + 1e-12;
-      if (state[i] < 0) kkt = kkt && grad(i) >= -1e-10;
-      if (state[i] > 0) kkt = kkt && grad(i) <= 1e-10;
+      if (state(i) == 0) kkt = kkt && v(i) >= p.lo(i) - 1e-12 && v(i) <= p.hi(i) + 1e-12;
+      if (state(i) < 0) kkt = kkt && grad(i) >= -1e-10;
+      if (state(i) > 0) kkt = kkt && grad(i) <= 1e-10;
     }
     if (kkt) return v;
   }

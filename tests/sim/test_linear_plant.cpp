@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include "core/mimo_model.hpp"
 #include "sim/linear_process.hpp"
@@ -64,19 +65,23 @@ Responses responses(const PlantModel& m, const PlantSpec& spec, const std::vecto
   return {step_response(a, u, kN), step_response(b, u, kN)};
 }
 
-ChannelEdit edit(const char* out, const char* in) {
-  ChannelEdit e;
-  e.output = out;
-  e.input = in;
-  return e;
+// A plant spec of one channel, input or output edit (named with designated
+// initialisers at the call: {.output = "y2", .input = "u1", .gain_factor = 1.2}).
+PlantSpec one_edit(ChannelEdit e) {
+  PlantSpec spec;
+  spec.channels = {std::move(e)};
+  return spec;
+}
+
+PlantSpec one_edit(InputEdit e) {
+  PlantSpec spec;
+  spec.inputs = {std::move(e)};
+  return spec;
 }
 
 TEST(LinearPlant, GainEditScalesOnlyThatChannelsSteadyState) {
   const PlantModel m = example_plant("wood-berry.yaml");
-  PlantSpec spec;
-  spec.channels = {edit("y2", "u1")};
-  spec.channels[0].gain_factor = 1.2;
-  const auto r = responses(m, spec, {1.0, 0.0});
+  const auto r = responses(m, one_edit({.output = "y2", .input = "u1", .gain_factor = 1.2}), {1.0, 0.0});
   EXPECT_NEAR(r.edited.back()[1] / r.nominal.back()[1], 1.2, 1e-9);
   for (std::size_t k = 0; k < kN; ++k) {
     EXPECT_DOUBLE_EQ(r.edited[k][0], r.nominal[k][0]);  // y1 <- u1 untouched
@@ -86,10 +91,7 @@ TEST(LinearPlant, GainEditScalesOnlyThatChannelsSteadyState) {
 
 TEST(LinearPlant, DelayEditShiftsTheStepResponse) {
   const PlantModel m = example_plant("wood-berry.yaml");
-  PlantSpec spec;
-  spec.channels = {edit("y1", "u2")};
-  spec.channels[0].extra_delay = 3;
-  const auto r = responses(m, spec, {0.0, 1.0});
+  const auto r = responses(m, one_edit({.output = "y1", .input = "u2", .extra_delay = 3}), {0.0, 1.0});
   for (std::size_t k = 0; k < kN; ++k) {
     const double shifted = k >= 3 ? r.nominal[k - 3][0] : 0.0;
     EXPECT_DOUBLE_EQ(r.edited[k][0], shifted) << k;
@@ -101,9 +103,7 @@ TEST(LinearPlant, DelayEditShiftsTheStepResponse) {
 // The paper's G12 edit: pole 0.9535 -> 0.9535 * 0.9, numerator unchanged.
 TEST(LinearPlant, PoleEditMovesThePoleAndWithItTheGain) {
   const PlantModel m = example_plant("wood-berry.yaml");
-  ChannelEdit e = edit("y1", "u2");
-  e.pole_factor = 0.9;
-  const DiscreteTf tf = edited_channel(m.channel(0, 1), e, 1.0);
+  const DiscreteTf tf = edited_channel(m.channel(0, 1), {.output = "y1", .input = "u2", .pole_factor = 0.9}, 1.0);
   ASSERT_EQ(tf.den.size(), 2u);
   EXPECT_NEAR(tf.den[1], -0.9535 * 0.9, 1e-12);
   EXPECT_NEAR(tf.dc_gain(), -0.8789 / (1 - 0.9535 * 0.9), 1e-9);
@@ -120,13 +120,11 @@ std::size_t rise_time(const std::vector<double>& y) {
 
 TEST(LinearPlant, TimeConstantEditKeepsTheGainAndSpeedsUp) {
   const PlantModel m = example_plant("wood-berry.yaml");
-  PlantSpec spec;
-  spec.channels = {edit("y2", "u1")};
-  spec.channels[0].time_constant_factor = 0.7;
-  const auto r = responses(m, spec, {1.0, 0.0});
+  const ChannelEdit faster{.output = "y2", .input = "u1", .time_constant_factor = 0.7};
+  const auto r = responses(m, one_edit(faster), {1.0, 0.0});
   EXPECT_NEAR(r.edited.back()[1], r.nominal.back()[1], 1e-6);
   const double tau_nominal = -1.0 / std::log(0.9123);
-  const DiscreteTf tf = edited_channel(m.channel(1, 0), spec.channels[0], 1.0);
+  const DiscreteTf tf = edited_channel(m.channel(1, 0), faster, 1.0);
   EXPECT_NEAR(-1.0 / std::log(-tf.den[1]), 0.7 * tau_nominal, 1e-9);
   // Dead time 8 samples in both; the lag part is 30 % faster.
   EXPECT_LT(rise_time(column(r.edited, 1)), rise_time(column(r.nominal, 1)));
@@ -134,9 +132,8 @@ TEST(LinearPlant, TimeConstantEditKeepsTheGainAndSpeedsUp) {
 
 TEST(LinearPlant, TimeConstantEditOnContinuousChannelRescalesTimeKeepingDeadTime) {
   const PlantModel m = example_plant("wood-berry-continuous.yaml");
-  ChannelEdit e = edit("y2", "u1");
-  e.time_constant_factor = 0.7;
-  const DiscreteTf tf = edited_channel(m.channel(1, 0), e, 1.0);
+  const DiscreteTf tf =
+      edited_channel(m.channel(1, 0), {.output = "y2", .input = "u1", .time_constant_factor = 0.7}, 1.0);
   const DiscreteTf expected = discretize_zoh(ContinuousTf{{6.6}, {10.9 * 0.7, 1.0}, 7.0}, 1.0);
   ASSERT_EQ(tf.num.size(), expected.num.size());
   for (std::size_t i = 0; i < tf.num.size(); ++i) EXPECT_NEAR(tf.num[i], expected.num[i], 1e-12);
@@ -146,10 +143,7 @@ TEST(LinearPlant, TimeConstantEditOnContinuousChannelRescalesTimeKeepingDeadTime
 
 TEST(LinearPlant, ExtraLagKeepsGainAndSlowsTheChannel) {
   const PlantModel m = example_plant("wood-berry.yaml");
-  PlantSpec spec;
-  spec.channels = {edit("y1", "u1")};
-  spec.channels[0].extra_lag_pole = 0.6;
-  const auto r = responses(m, spec, {1.0, 0.0});
+  const auto r = responses(m, one_edit({.output = "y1", .input = "u1", .extra_lag_pole = 0.6}), {1.0, 0.0});
   EXPECT_NEAR(r.edited.back()[0], r.nominal.back()[0], 1e-6);
   EXPECT_GT(rise_time(column(r.edited, 0)), rise_time(column(r.nominal, 0)));
   for (std::size_t k = 3; k < 40; ++k) EXPECT_LT(r.edited[k][0], r.nominal[k][0]) << k;
@@ -157,10 +151,7 @@ TEST(LinearPlant, ExtraLagKeepsGainAndSlowsTheChannel) {
 
 TEST(LinearPlant, IntegratorEditTurnsTheStepResponseIntoARamp) {
   const PlantModel m = example_plant("quad-tank-4x4.yaml");
-  PlantSpec spec;
-  spec.channels = {edit("y3", "u2")};
-  spec.channels[0].add_integrator = true;
-  Plant p = build(m, spec);
+  Plant p = build(m, one_edit({.output = "y3", .input = "u2", .add_integrator = true}));
   const auto y = step_response(p, {0.0, 1.0, 0.0, 0.0}, 200);
   // G32 = 0.078/(0.028 s + 0.25) is static at Ts = 2 s: G32/s ramps at 0.312/s.
   EXPECT_NEAR(y[199][2] - y[198][2], 0.312 * 2.0, 1e-6);
@@ -169,30 +160,24 @@ TEST(LinearPlant, IntegratorEditTurnsTheStepResponseIntoARamp) {
 
 TEST(LinearPlant, MissingChannelIsAdded) {
   const PlantModel m = example_plant("quad-tank-4x4.yaml");
-  PlantSpec spec;
-  spec.channels = {edit("y3", "u3")};
-  spec.channels[0].replace_continuous = ContinuousTf{{0.2}, {1.0, 0.02}, 0.0};
-  const auto r = responses(m, spec, {0.0, 0.0, 1.0, 0.0});
+  const ChannelEdit added{.output = "y3", .input = "u3", .replace_continuous = ContinuousTf{{0.2}, {1.0, 0.02}, 0.0}};
+  const auto r = responses(m, one_edit(added), {0.0, 0.0, 1.0, 0.0});
   EXPECT_EQ(r.nominal[399][2], 0.0);        // model: u3 does nothing to y3
   EXPECT_NEAR(r.edited[399][2], 10.0 * (1 - std::exp(-0.02 * 2 * 399)), 1e-6);  // 0.2/(s+0.02): gain 10
 }
 
 TEST(LinearPlant, EditsOfUnknownSignalsOrTwiceTheSameChannelAreRejected) {
   const PlantModel m = example_plant("wood-berry.yaml");
-  PlantSpec spec;
-  spec.channels = {edit("y9", "u1")};
-  EXPECT_THROW(build(m, spec), std::invalid_argument);
-  spec.channels = {edit("y1", "u1"), edit("y1", "u1")};
-  EXPECT_THROW(build(m, spec), std::invalid_argument);
-  spec.channels = {edit("y1", "u1")};
-  spec.channels[0].extra_lag_pole = 1.0;
-  EXPECT_THROW(build(m, spec), std::invalid_argument);
+  EXPECT_THROW(build(m, one_edit({.output = "y9", .input = "u1"})), std::invalid_argument);
+  PlantSpec twice;
+  twice.channels = {{.output = "y1", .input = "u1"}, {.output = "y1", .input = "u1"}};
+  EXPECT_THROW(build(m, twice), std::invalid_argument);
+  EXPECT_THROW(build(m, one_edit({.output = "y1", .input = "u1", .extra_lag_pole = 1.0})), std::invalid_argument);
 }
 
 TEST(Instruments, ActuatorLagSlowsEveryChannelOfThatInputAlike) {
   const PlantModel m = example_plant("wood-berry.yaml");
-  PlantSpec spec;
-  spec.inputs = {InputEdit{"u2", 0.45}};
+  const PlantSpec spec = one_edit(InputEdit{.input = "u2", .actuator_lag_pole = 0.45});
   const auto r = responses(m, spec, {0.0, 1.0});
   // Each edited response is the nominal one through (1-p)/(1-p q^-1).
   for (std::size_t j = 0; j < 2; ++j) {
@@ -210,10 +195,7 @@ TEST(Instruments, ActuatorLagSlowsEveryChannelOfThatInputAlike) {
 
 TEST(Instruments, SaturationClipsTheEffectiveInput) {
   const PlantModel m = example_plant("wood-berry.yaml");
-  PlantSpec spec;
-  InputEdit sat{"u1"};
-  sat.upper_limit = 0.9;
-  spec.inputs = {sat};
+  const PlantSpec spec = one_edit(InputEdit{.input = "u1", .upper_limit = 0.9});
   const auto big = responses(m, spec, {2.0, 0.0});
   EXPECT_NEAR(big.edited.back()[0] / big.nominal.back()[0], 0.9 / 2.0, 1e-9);
   const auto small = responses(m, spec, {0.5, 0.0});  // inside the limit: no effect
@@ -224,10 +206,7 @@ TEST(Instruments, SaturationClipsTheEffectiveInput) {
 
 TEST(Instruments, DeadbandIgnoresSmallMovesAndLosesHalfTheBandOnLargeOnes) {
   const PlantModel m = example_plant("wood-berry.yaml");
-  PlantSpec spec;
-  InputEdit backlash{"u2"};
-  backlash.deadband_width = 0.5;
-  spec.inputs = {backlash};
+  const PlantSpec spec = one_edit(InputEdit{.input = "u2", .deadband_width = 0.5});
   const auto small = responses(m, spec, {0.0, 0.2});
   for (std::size_t k = 0; k < kN; ++k) {
     EXPECT_EQ(small.edited[k][0], 0.0);

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "core/transfer_function.hpp"
 #include "sim/mpc.hpp"
@@ -23,6 +25,18 @@ MpcSettings table2() {
   s.move_weights = {1.0, 2.0};
   return s;
 }
+
+// Table 2 with input limits.
+MpcSettings table2(std::vector<double> lower, std::vector<double> upper) {
+  MpcSettings s = table2();
+  s.input_lower = std::move(lower);
+  s.input_upper = std::move(upper);
+  return s;
+}
+
+// Wood-Berry's steady-state gains G(1) (wood-berry.yaml).
+constexpr double kG11 = 0.744 / (1 - 0.9419), kG12 = -0.8789 / (1 - 0.9535);
+constexpr double kG21 = 0.5786 / (1 - 0.9123), kG22 = -1.302 / (1 - 0.9329);
 
 // Runs plant + controller for n samples with setpoint r and an output
 // disturbance d_from_k (added from sample k_d on); returns the last y and u
@@ -58,10 +72,8 @@ TEST(Dmc, MatchedModelTracksASetpointStep) {
   EXPECT_NEAR(r.y[1], -0.5, 1e-4);
   EXPECT_EQ(mpc.constrained_samples(), 0u);
   // Steady state inputs solve G(1) u = r.
-  const double g11 = 0.744 / (1 - 0.9419), g12 = -0.8789 / (1 - 0.9535);
-  const double g21 = 0.5786 / (1 - 0.9123), g22 = -1.302 / (1 - 0.9329);
-  EXPECT_NEAR(g11 * r.u[0] + g12 * r.u[1], 1.0, 1e-4);
-  EXPECT_NEAR(g21 * r.u[0] + g22 * r.u[1], -0.5, 1e-4);
+  EXPECT_NEAR(kG11 * r.u[0] + kG12 * r.u[1], 1.0, 1e-4);
+  EXPECT_NEAR(kG21 * r.u[0] + kG22 * r.u[1], -0.5, 1e-4);
 }
 
 TEST(Dmc, BiasCorrectionRemovesAnUnmeasuredStepDisturbance) {
@@ -86,9 +98,7 @@ TEST(Dmc, TracksOnTheFourByFourModelWithSecondOrderAndZeroChannels) {
 
 TEST(Dmc, HonoursInputLimits) {
   const PlantModel m = example_plant("wood-berry.yaml");
-  MpcSettings s = table2();
-  s.input_lower = {-0.3, -0.2};
-  s.input_upper = {0.3, 0.25};
+  const MpcSettings s = table2({-0.3, -0.2}, {0.3, 0.25});
   DmcController mpc(m, s);
   // Unconstrained, this setpoint needs u = (0.85, 0.55) or so.
   const LoopResult r = run_loop(m, mpc, {3.0, 1.0}, 600);
@@ -106,21 +116,17 @@ TEST(Dmc, InputLimitsBindWhereClippingWouldBeWorse) {
   // With u1 pinned at its limit, the QP re-plans u2; clipping the
   // unconstrained move would not. Compare the y2 error after the transient.
   const PlantModel m = example_plant("wood-berry.yaml");
-  MpcSettings s = table2();
-  s.input_lower = {-0.2, -10.0};
-  s.input_upper = {0.2, 10.0};
+  const MpcSettings s = table2({-0.2, -10.0}, {0.2, 10.0});
   DmcController mpc(m, s);
   const LoopResult r = run_loop(m, mpc, {2.0, 0.0}, 800);
   EXPECT_NEAR(r.u[0], 0.2, 1e-9);
   // With u1 at 0.2, y2 = 0 needs u2 = -g21 u1 / g22 exactly (weight 50 on y2).
-  const double g21 = 0.5786 / (1 - 0.9123), g22 = -1.302 / (1 - 0.9329);
-  const double g11 = 0.744 / (1 - 0.9419), g12 = -0.8789 / (1 - 0.9535);
-  const double y2 = g21 * r.u[0] + g22 * r.u[1];
-  const double y1 = g11 * r.u[0] + g12 * r.u[1];
+  const double y2 = kG21 * r.u[0] + kG22 * r.u[1];
+  const double y1 = kG11 * r.u[0] + kG12 * r.u[1];
   EXPECT_NEAR(r.y[1], y2, 1e-6);
   EXPECT_NEAR(r.y[0], y1, 1e-6);
   // Weighted steady-state optimum over u2 alone: minimise (2 - y1)^2 + 50 y2^2.
-  const double a1 = g12, b1 = 2.0 - g11 * 0.2, a2 = g22, b2 = -g21 * 0.2;
+  const double a1 = kG12, b1 = 2.0 - kG11 * 0.2, a2 = kG22, b2 = -kG21 * 0.2;
   const double u2_best = (a1 * b1 + 50.0 * a2 * b2) / (a1 * a1 + 50.0 * a2 * a2);
   EXPECT_NEAR(r.u[1], u2_best, 1e-4);
 }
@@ -131,22 +137,22 @@ TEST(Dmc, FirstMoveIsTheLeastSquaresDmcMove) {
   const PlantModel m = example_plant("wood-berry.yaml");
   const MpcSettings s = table2();
   const int p = 100, mm = 10;
-  std::vector<std::vector<double>> step(4, std::vector<double>(p + 1, 0.0));  // [j*2+l][n]
+  Eigen::MatrixXd step = Eigen::MatrixXd::Zero(4, p + 1);  // (j*2+l, n)
   for (const auto& c : m.channels) {
     DiscreteFilter f(c.tf);
-    for (int n = 0; n <= p; ++n) step[c.output * 2 + c.input][n] = f.step(1.0);
+    for (int n = 0; n <= p; ++n) step(static_cast<Eigen::Index>(c.output * 2 + c.input), n) = f.step(1.0);
   }
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(2 * p, 2 * mm);
   Eigen::VectorXd w(2 * p), e(2 * p);
   for (int i = 1; i <= p; ++i)
     for (int j = 0; j < 2; ++j) {
-      w((i - 1) * 2 + j) = s.output_weights[j];
+      w((i - 1) * 2 + j) = s.output_weights[static_cast<std::size_t>(j)];
       e((i - 1) * 2 + j) = j == 0 ? 1.0 : 0.0;  // r = (1, 0), free response 0
       for (int k = 0; k < mm && k <= i; ++k)
-        for (int l = 0; l < 2; ++l) a((i - 1) * 2 + j, k * 2 + l) = step[j * 2 + l][i - k];
+        for (int l = 0; l < 2; ++l) a((i - 1) * 2 + j, k * 2 + l) = step(j * 2 + l, i - k);
     }
   Eigen::VectorXd rw(2 * mm);
-  for (int k = 0; k < 2 * mm; ++k) rw(k) = s.move_weights[k % 2];
+  for (int k = 0; k < 2 * mm; ++k) rw(k) = s.move_weights[static_cast<std::size_t>(k % 2)];
   const Eigen::MatrixXd h = a.transpose() * w.asDiagonal() * a + Eigen::MatrixXd(rw.asDiagonal());
   const Eigen::VectorXd moves = h.ldlt().solve(a.transpose() * w.asDiagonal() * e);
 
@@ -189,10 +195,7 @@ TEST(Dmc, RejectsBadSettingsAndUnstableModels) {
   s = table2();
   s.move_weights = {1.0, 0.0};
   EXPECT_THROW(DmcController(m, s), std::invalid_argument);
-  s = table2();
-  s.input_lower = {1.0, 0.0};
-  s.input_upper = {0.0, 1.0};
-  EXPECT_THROW(DmcController(m, s), std::invalid_argument);
+  EXPECT_THROW(DmcController(m, table2({1.0, 0.0}, {0.0, 1.0})), std::invalid_argument);
   PlantModel unstable = m;
   unstable.channels[0].tf.den = {1.0, -1.01};
   EXPECT_THROW(DmcController(unstable, table2()), std::invalid_argument);

@@ -1,7 +1,6 @@
 // Messages with every field set to something recognisable, for round trips.
 #pragma once
 
-#include <cmath>
 #include <limits>
 
 #include "transport/messages.hpp"
@@ -66,6 +65,5 @@ inline msg::Status full_status() {
   return s;
 }
 
-inline bool same_double(double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; }
 
 }  // namespace mpm::test

@@ -13,6 +13,7 @@
 #include <ostream>
 #include <vector>
 
+#include "same_message.hpp"
 #include "sample_messages.hpp"
 #include "transport/fake_transport.hpp"
 #include "transport/lcm_codec.hpp"
@@ -85,14 +86,7 @@ TEST_P(TransportContract, SamplesArriveInOrderWithEveryField) {
     EXPECT_EQ(got[static_cast<std::size_t>(k - 1)].seq, k);
     EXPECT_EQ(got[static_cast<std::size_t>(k - 1)].u[0], k);
   }
-  const msg::Sample& last = got.back();
-  EXPECT_EQ(last.controller_id, s.controller_id);
-  EXPECT_EQ(last.session_id, s.session_id);
-  EXPECT_EQ(last.utime, s.utime);
-  EXPECT_EQ(last.y, s.y);
-  EXPECT_EQ(last.sim_y, s.sim_y);
-  EXPECT_EQ(last.extra_names, s.extra_names);
-  EXPECT_EQ(last.extra_values, s.extra_values);
+  test::expect_same_message(got.back(), s);
   EXPECT_EQ(subscriber_->receive_errors(), 0u);
 }
 
@@ -110,16 +104,9 @@ TEST_P(TransportContract, AlarmsAndStatusArrive) {
   ASSERT_TRUE(publisher_->publish(a));
   ASSERT_TRUE(publisher_->publish(test::full_status()));
   ASSERT_TRUE(pump(*subscriber_, [&] { return alarms.size() >= 2 && !status.empty(); }));
-  EXPECT_EQ(alarms[0].input, "u1");
-  EXPECT_TRUE(alarms[0].raised);
-  EXPECT_EQ(alarms[0].text, test::full_alarm().text);
-  EXPECT_EQ(alarms[1].input, "u2");
-  EXPECT_FALSE(alarms[1].raised);
-  EXPECT_EQ(status[0].controller_id, "column-7");
-  ASSERT_EQ(status[0].channels.size(), 2u);
-  EXPECT_EQ(status[0].channels[1].lr, 60.0);
-  EXPECT_EQ(status[0].loops[0].output, "y1");
-  EXPECT_EQ(status[0].nan_samples, 8);
+  test::expect_same_message(alarms[0], test::full_alarm());
+  test::expect_same_message(alarms[1], a);
+  test::expect_same_message(status[0], test::full_status());
 }
 
 TEST_P(TransportContract, OnlySubscribedKindsAreDelivered) {
@@ -139,9 +126,9 @@ TEST_P(TransportContract, HandleTimesOutWithoutTraffic) {
 }
 
 INSTANTIATE_TEST_SUITE_P(All, TransportContract, ::testing::Values(Impl::kFake, Impl::kLcm, Impl::kDds),
-                         [](const auto& info) {
-                           return std::string(info.param == Impl::kFake  ? "Fake"
-                                              : info.param == Impl::kLcm ? "Lcm"
+                         [](const auto& test) {
+                           return std::string(test.param == Impl::kFake  ? "Fake"
+                                              : test.param == Impl::kLcm ? "Lcm"
                                                                          : "Dds");
                          });
 
