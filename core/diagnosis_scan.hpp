@@ -54,7 +54,7 @@ double share_rate(DetectorSettings& sequential, const ScanSettings& scan, double
 
 class DiagnosisScan {
  public:
-  DiagnosisScan() = default;
+  DiagnosisScan() { settings_.interval = 0; }  // off
   // rate_per_sample: the scan's share (share_rate).
   DiagnosisScan(std::size_t outputs, const ScanSettings& settings, double rate_per_sample);
 
