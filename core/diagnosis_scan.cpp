@@ -36,7 +36,9 @@ DiagnosisScan::DiagnosisScan(std::size_t outputs, const ScanSettings& settings, 
 bool DiagnosisScan::on_ready_sample() noexcept {
   if (settings_.interval == 0) return false;
   ++since_ready_;
-  return since_ready_ >= settings_.min_samples && (since_ready_ - settings_.min_samples) % settings_.interval == 0;
+  const bool due = since_ready_ >= settings_.min_samples && (since_ready_ - settings_.min_samples) % settings_.interval == 0;
+  checkpoints_ += due ? 1 : 0;
+  return due;
 }
 
 std::size_t DiagnosisScan::look_length() const noexcept { return std::min(settings_.window, since_ready_); }

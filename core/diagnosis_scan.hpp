@@ -91,13 +91,14 @@ class DiagnosisScan {
   void skip() noexcept { ++skipped_; }
 
   bool raised(std::size_t output) const noexcept { return raised_[output] != 0; }
-  std::uint64_t looks() const noexcept { return looks_; }
+  std::uint64_t checkpoints() const noexcept { return checkpoints_; }  // looks due so far
+  std::uint64_t looks() const noexcept { return looks_; }              // concluded
   std::uint64_t skipped() const noexcept { return skipped_; }
   const ScanSettings& settings() const noexcept { return settings_; }
 
   template <class V>
   void visit_state(V&& v) {  // checkpoint
-    v(since_ready_); v(raised_); v(clean_); v(looks_); v(skipped_);
+    v(since_ready_); v(raised_); v(clean_); v(checkpoints_); v(looks_); v(skipped_);
   }
 
  private:
@@ -106,6 +107,7 @@ class DiagnosisScan {
   std::size_t since_ready_ = 0;
   std::vector<std::uint8_t> raised_;
   std::vector<int> clean_;
+  std::uint64_t checkpoints_ = 0;
   std::uint64_t looks_ = 0;
   std::uint64_t skipped_ = 0;
 };

@@ -80,6 +80,11 @@ bool DiagnosisWorker::take(msg::Diagnosis& out) {
   return true;
 }
 
+bool DiagnosisWorker::idle() const {
+  std::lock_guard lock(mutex_);
+  return !busy_ && !pending_ && !result_ && !look_result_;
+}
+
 bool DiagnosisWorker::take_look(LookResult& out) {
   std::lock_guard lock(mutex_);
   if (!look_result_) return false;
@@ -120,8 +125,6 @@ void DiagnosisWorker::run() {
         log::write(log::Level::kError, "diagnosis scan look at sample %lld failed: %s",
                    static_cast<long long>(l->seq), e.what());
       }
-      log::write(log::Level::kDebug, "diagnosis scan look over %zu samples at level %.3g (%.2f s)", l->rows, l->alpha,
-                 seconds());
       std::lock_guard lock(mutex_);
       look_result_ = std::move(out);
       busy_ = false;

@@ -90,6 +90,9 @@ class DiagnosisWorker {
   // Main thread: a finished look (true).
   bool take_look(LookResult& out);
 
+  // Nothing handed over, pending or waiting to be taken (tests wait for it).
+  bool idle() const;
+
   std::uint64_t coalesced() const noexcept { return coalesced_; }
   std::uint64_t completed() const noexcept { return completed_.load(); }
   std::size_t window() const noexcept { return window_; }
@@ -113,7 +116,7 @@ class DiagnosisWorker {
   std::size_t window_;
   SampleRing ring_;  // window x (inputs, then residuals)
 
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::condition_variable wake_;
   std::thread thread_;
   bool stop_ = false;

@@ -64,8 +64,9 @@ struct ServiceSettings {
   // Usable samples between looks of the diagnosis scan over the last
   // diagnosis_window samples (needs diagnosis_window > 0); 0 = no scan. The
   // scan takes its share of monitor.detector.false_alarms_per_year
-  // (share_rate). `mpm monitor --scan-interval`.
-  int scan_interval = 500;
+  // (share_rate). `mpm monitor --scan-interval`. Off here (unit tests of
+  // the sequential path); mpmd's configuration turns it on (500).
+  int scan_interval = 0;
 };
 
 struct ServiceCounters {
