@@ -18,6 +18,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--mpm", default=os.path.join(root, "build", "daemon", "mpm"))
     ap.add_argument("--data", default="/work/shared/data")
+    ap.add_argument("--live-args", default="", help="extra mpm monitor options, e.g. '--diagnosis-window 10000'")
     args = ap.parse_args()
     print(f"{'case':38s} {'truth':18s} {'offline':14s} {'live raises (output/channel@sample(detector))':60s} agree")
     tally = {"flagged": 0, "raised_all": 0, "raised_any": 0, "wrong_output": 0, "nominal": 0, "nominal_raised": 0}
@@ -35,7 +36,7 @@ def main():
             offline = [l["output"] for l in diag["loops"] if l.get("mismatch")]
         except (ValueError, KeyError):
             offline = ["error"]
-        ev = subprocess.run([args.mpm, "monitor", "--plant", plant, "--data", run, "--forgetting", "0.999", "--events"],
+        ev = subprocess.run([args.mpm, "monitor", "--plant", plant, "--data", run, "--forgetting", "0.999", "--events"] + args.live_args.split(),
                             capture_output=True, text=True)
         raises = [json.loads(l) for l in ev.stdout.splitlines() if '"raised"' in l]
         first = {}
