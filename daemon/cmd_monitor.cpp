@@ -53,9 +53,9 @@ constexpr const char* kUsage =
     "                     alarms mpmd publishes for the same samples and settings (one thread;\n"
     "                     --forgetting 0.999 is mpmd's default memory): the sequential\n"
     "                     detector's per channel, and the diagnosis scan's per output\n"
-    "  --scan-interval N  --events: usable samples between looks of the diagnosis scan (mpmd's\n"
-    "                     scan_interval; default 500; 0 = no scan, the sequential detector\n"
-    "                     then has the whole stated rate)\n"
+    "  --scan-interval N  usable samples between looks of the diagnosis scan (run with --events; mpmd's\n"
+    "                     scan_interval; default 500: the scan has half the stated rate, the\n"
+    "                     sequential detector the other half; 0 = no scan, all to the latter)\n"
     "  --diagnosis-window N  --events: most recent samples a scan look diagnoses (mpmd's\n"
     "                     diagnosis_window; default 3000)\n"
     "  --false-alarms-per-year R  stated false-alarm rate of the live detector for the\n"
@@ -253,17 +253,18 @@ int run(int argc, char** argv) {
     if (const std::string e = settings.validate(); !e.empty()) throw UsageError(e);
     const int requested_threads = args.integer("threads", 0);  // 0: one per core
     if (args.get("threads") && requested_threads < 1) throw UsageError("--threads must be >= 1");
-    // The diagnosis scan runs with --events (the live path); it takes its
-    // share of the stated rate from the sequential detector (share_rate).
+    // The diagnosis scan takes its share of the stated rate from the
+    // sequential detector (share_rate) as in mpmd, so that the table's
+    // 'first raised' is mpmd's sequential detector; it runs with --events.
     const bool events = args.flag("events");
     ScanSettings scan;
-    scan.interval = events ? static_cast<std::size_t>(std::max(0, args.integer("scan-interval", 500))) : 0;
+    scan.interval = static_cast<std::size_t>(std::max(0, args.integer("scan-interval", 500)));
     scan.window = static_cast<std::size_t>(std::max(0, args.integer("diagnosis-window", 3000)));
     scan.min_samples = std::min(scan.min_samples, scan.window);
     if (const std::string e = scan.validate(); !e.empty()) throw UsageError(e);
     const double scan_rate = share_rate(settings.detector, scan, plant.sample_time);
     std::optional<ScanReplay> replay;
-    if (scan.interval > 0) replay.emplace(plant, scan, scan_rate);
+    if (events && scan.interval > 0) replay.emplace(plant, scan, scan_rate);
     const int settle = args.integer("settle-samples", -1);  // -1: settle_length's automatic rule
     if (settle < -1) throw UsageError("--settle-samples must be >= 0 (or -1: automatic)");
 
