@@ -61,6 +61,7 @@ void SampleRing::record(const double* u, const double* residual) noexcept {
 
 void SampleRing::copy_last(std::size_t n, Eigen::MatrixXd& out) const noexcept {
   const std::size_t rows = capacity();
+  if (rows == 0) return;
   n = std::min(n, filled_);
   // head_ is the next row to write: the newest is head_ - 1.
   const std::size_t start = (head_ + rows - n) % rows;
