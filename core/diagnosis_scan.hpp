@@ -87,6 +87,11 @@ class DiagnosisScan {
       }
     }
   }
+  // The output's alarm is withdrawn from outside (the service is replaced).
+  void lower(std::size_t output) noexcept {
+    raised_[output] = 0;
+    clean_[output] = 0;
+  }
   // A look that was due but not run (mpmd: the diagnosis thread was busy).
   void skip() noexcept { ++skipped_; }
 

@@ -271,6 +271,21 @@ void MonitorService::republish_raised(const std::string& reason) {
 
 void MonitorService::retire(const std::string& reason) {
   const std::size_t n_in = plant_.n_inputs();
+  // The scan's raised outputs too (their state is not carried over).
+  for (std::size_t j = 0; j < plant_.n_outputs() && scan_.enabled(); ++j) {
+    if (!scan_.raised(j)) continue;
+    scan_.lower(j);
+    fill_alarm_header(j, 0, 0, tracker_.last());
+    alarm_.input.clear();
+    alarm_.input_index = -1;
+    alarm_.raised = false;
+    alarm_.f = alarm_.gamma = kNaN;
+    alarm_.p_value = scan_.alpha_look();
+    alarm_.physics.clear();
+    alarm_.text = "diagnosis scan: cleared " + alarm_.output + ": no longer watched by this monitor (" + reason + ")";
+    log::write(log::Level::kNotice, "controller '%s': %s", settings_.controller_id.c_str(), alarm_.text.c_str());
+    if (on_alarm_) on_alarm_(alarm_);
+  }
   for (std::size_t j = 0; j < plant_.n_outputs(); ++j) {
     for (std::size_t i = 0; i < n_in; ++i) {
       if (!edges_.raised(j, i)) continue;

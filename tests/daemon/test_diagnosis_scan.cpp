@@ -25,11 +25,14 @@ namespace {
 struct ScanRun {
   std::vector<msg::Alarm> alarms;
   std::vector<msg::Diagnosis> diagnoses;
+  std::vector<msg::Alarm> retired;  // published by the retire at the end
   std::uint64_t looks = 0;
 };
 
 // per_alarm > 0: the stated rate is one false alarm per that many samples.
-ScanRun run(const char* scenario, std::uint64_t seed, std::size_t samples, double per_alarm = 0.0) {
+// retire: the service is replaced at the end (a reload): its raised alarms are withdrawn.
+ScanRun run(const char* scenario, std::uint64_t seed, std::size_t samples, double per_alarm = 0.0,
+            bool retire = false) {
   const sim::Scenario* sc = sim::find_scenario(scenario);
   const PlantModel model = sim::default_plant(*sc).model;
   sim::ClosedLoop loop(model, sim::scenario_loop(*sc, model), seed);
@@ -60,13 +63,24 @@ ScanRun run(const char* scenario, std::uint64_t seed, std::size_t samples, doubl
   }
   EXPECT_EQ(service.scan().skipped(), 0u);
   out.looks = service.scan().looks();
+  if (retire) {
+    const std::size_t n = out.alarms.size();
+    service.retire("reload");
+    out.retired.assign(out.alarms.begin() + static_cast<std::ptrdiff_t>(n), out.alarms.end());
+    out.alarms.resize(n);
+  }
   return out;
 }
 
 bool from_scan(const msg::Alarm& a) { return a.text.rfind("diagnosis scan:", 0) == 0; }
 
 TEST(DiagnosisScanService, RaisesAConcealedTimeConstantChangeFirstWithItsPhysics) {
-  const ScanRun r = run("wood-berry-g21-time-constant", 1, 4000);
+  const ScanRun r = run("wood-berry-g21-time-constant", 1, 4000, 0.0, true);
+  // The reload withdrew the scan's raise of y2 first.
+  ASSERT_FALSE(r.retired.empty());
+  const msg::Alarm& withdrawn = r.retired.front();
+  EXPECT_TRUE(from_scan(withdrawn) && !withdrawn.raised && withdrawn.output == "y2") << withdrawn.text;
+  EXPECT_NE(withdrawn.text.find("no longer watched"), std::string::npos) << withdrawn.text;
   EXPECT_GE(r.looks, 3u);
   ASSERT_FALSE(r.alarms.empty());
   const msg::Alarm& first = r.alarms.front();
