@@ -168,6 +168,9 @@ void read_checkpoint(const YamlReader& r, const Field& root, const std::string& 
   read(r, root, "diagnosis_window", c.diagnosis_window);
   if (c.diagnosis_window != 0 && (c.diagnosis_window < 200 || c.diagnosis_window > 1000000))
     r.fail(r.child(root, "diagnosis_window"), "expected 0 (off) or a number of samples in 200..1000000");
+  read(r, root, "scan_interval", c.scan_interval);
+  if (c.scan_interval != 0 && (c.scan_interval < 50 || c.scan_interval > 10000000))
+    r.fail(r.child(root, "scan_interval"), "expected 0 (off) or a number of samples in 50..10000000");
 }
 
 // limits: {max_inputs: 200, ...}: the caps on the plant file (limits.hpp).
@@ -197,7 +200,7 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
   try {
     r.check_keys(root, {"controller_id", "plant", "monitor", "transport", "status_period", "queue_capacity",
                         "log_interval", "max_sequence_jump", "stale_after", "checkpoint_path",
-                        "checkpoint_interval", "diagnosis_window", "limits"});
+                        "checkpoint_interval", "diagnosis_window", "scan_interval", "limits"});
     DaemonConfig c;
     c.source = source_name;
     c.controller_id = r.name(r.child(root, "controller_id"));

@@ -25,6 +25,7 @@
 //   checkpoint_path: /var/lib/mpm/mpmd.state  # relative to this file; absent = no checkpoint
 //   checkpoint_interval: 60         # seconds between checkpoints (also written at SIGTERM)
 //   diagnosis_window: 3000          # samples diagnosed (physics) at a raise; 0 = off
+//   scan_interval: 500              # usable samples between diagnosis scan looks; 0 = off
 //   limits: {max_inputs: 100, max_outputs: 100, max_poly_length: 200,   # caps on the plant
 //            max_delay_samples: 1000, max_yaml_bytes: 67108864}         # file (limits.hpp)
 #pragma once
@@ -55,6 +56,7 @@ struct DaemonConfig {
   std::string checkpoint_path; // monitor state saved here and resumed at start; "" = none
   double checkpoint_interval = 60.0;  // seconds between checkpoints (and one at SIGTERM)
   int diagnosis_window = 3000; // recent samples diagnosed when an output is raised; 0 = none
+  int scan_interval = 500;     // usable samples between looks of the diagnosis scan; 0 = none
   Limits limits;               // caps on the plant file (the config file itself: the defaults)
 };
 

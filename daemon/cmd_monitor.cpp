@@ -1,12 +1,16 @@
 // `mpm monitor`: replays a recording through the online Granger monitor, as
 // mpmd would see it live, and prints the per-channel statistics and alarms.
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <cstdio>
 #include <string>
 #include <vector>
 
 #include "config/plant_loader.hpp"
 #include "core/chi_square.hpp"
+#include "core/diagnosis_scan.hpp"
 #include "core/granger_monitor.hpp"
 #include "core/mimo_model.hpp"
 #include "daemon/args.hpp"
@@ -14,6 +18,7 @@
 #include "daemon/data_input.hpp"
 #include "daemon/limit_flags.hpp"
 #include "daemon/offline.hpp"
+#include "daemon/scan_look.hpp"
 #include "daemon/stream_monitor.hpp"
 
 namespace mpm {
@@ -44,9 +49,15 @@ constexpr const char* kUsage =
     "                     threads (default: one thread, the record read as a stream, memory\n"
     "                     independent of its length; the result does not depend on it)\n"
     "  --json             print one JSON object instead of the table\n"
-    "  --events           print the live detector's raise and clear events of each channel\n"
-    "                     as JSON lines: the alarms mpmd publishes for the same samples and\n"
-    "                     settings (one thread; --forgetting 0.999 is mpmd's default memory)\n"
+    "  --events           print the live detectors' raise and clear events as JSON lines: the\n"
+    "                     alarms mpmd publishes for the same samples and settings (one thread;\n"
+    "                     --forgetting 0.999 is mpmd's default memory): the sequential\n"
+    "                     detector's per channel, and the diagnosis scan's per output\n"
+    "  --scan-interval N  usable samples between looks of the diagnosis scan (run with --events; mpmd's\n"
+    "                     scan_interval; default 500: the scan has half the stated rate, the\n"
+    "                     sequential detector the other half; 0 = no scan, all to the latter)\n"
+    "  --diagnosis-window N  --events: most recent samples a scan look diagnoses (mpmd's\n"
+    "                     diagnosis_window; default 3000)\n"
     "  --false-alarms-per-year R  stated false-alarm rate of the live detector for the\n"
     "                     whole controller (default 1; the sample time is the plant's)\n"
     "  --crossing-constant C  the detector's crossing-rate constant (from mpm calibrate)\n"
@@ -140,18 +151,87 @@ void print_event(const PlantModel& plant, const GrangerMonitor& m, std::size_t k
   const AlarmFacts f = alarm_facts(m, j, i);
   std::printf("{\"event\": \"%s\", \"sample\": %zu, \"output\": \"%s\", \"channel\": \"%s\", \"statistic\": %s, "
               "\"threshold\": %s, \"window\": %s, \"p_value\": %s, \"F_conditional\": %s, \"gamma\": %s, "
-              "\"conditional_score\": %s, \"by_gamma\": %s, \"physics\": null}\n",
+              "\"conditional_score\": %s, \"by_gamma\": %s, \"physics\": null, \"detector\": \"sequential\"}\n",
               f.raised ? "raised" : "cleared", k, plant.outputs[j].c_str(), plant.inputs[i].c_str(),
               exact(f.statistic).c_str(), exact(f.threshold).c_str(), exact(f.window).c_str(), exact(f.p_value).c_str(),
               exact(f.f_conditional).c_str(), exact(f.gamma).c_str(), exact(f.conditional_score).c_str(),
               f.by_gamma ? "true" : "false");
 }
 
+// One JSON line per raise or clear of an output by the diagnosis scan: the
+// finding's channel, physics, fitted parameters and held-out improvement (a
+// raise), the look's window and level; what mpmd publishes for the same look.
+void print_scan_event(const PlantModel& plant, std::size_t k, std::size_t j, bool raised, const msg::Diagnosis& d,
+                      const std::optional<std::size_t>& input, double lr, std::size_t window, double alpha) {
+  std::string params = "{";
+  for (std::size_t n = 0; n < d.parameter_names.size(); ++n)
+    params += (n ? ", " : "") + json_quoted(d.parameter_names[n]) + ": " + exact(d.parameter_values[n]);
+  params += "}";
+  std::printf("{\"event\": \"%s\", \"sample\": %zu, \"output\": \"%s\", \"channel\": %s, \"statistic\": %s, "
+              "\"threshold\": null, \"window\": %zu, \"p_value\": %s, \"physics\": %s, \"detector\": \"scan\", "
+              "\"parameters\": %s, \"holdout_improvement\": %s, \"channels\": %s, \"text\": %s}\n",
+              raised ? "raised" : "cleared", k, plant.outputs[j].c_str(),
+              input ? json_quoted(plant.inputs[*input]).c_str() : "null", raised ? exact(lr).c_str() : "null", window,
+              exact(alpha).c_str(), raised ? json_quoted(d.physics).c_str() : "null", params.c_str(),
+              raised ? exact(d.holdout_improvement).c_str() : "null", json_quoted(d.channels).c_str(),
+              json_quoted(d.text).c_str());
+}
+
+// The diagnosis scan run at once at its checkpoints (mpmd runs the same
+// looks on its diagnosis thread): a ring of the rows mpmd keeps, the
+// schedule, and the events of each look.
+class ScanReplay {
+ public:
+  ScanReplay(const PlantModel& plant, const ScanSettings& settings, double rate_per_sample)
+      : plant_(plant),
+        nominal_(channel_models(plant)),
+        scan_(plant.n_outputs(), settings, rate_per_sample),
+        ring_(settings.window, plant.n_inputs(), plant.n_outputs()),
+        snapshot_(static_cast<Eigen::Index>(settings.window), static_cast<Eigen::Index>(plant.n_inputs() + plant.n_outputs())),
+        nan_(plant.n_outputs(), std::numeric_limits<double>::quiet_NaN()) {}
+
+  void on_row(const double* u, const double* d, ResidualFrontEnd::Stage stage) {
+    ring_.record(u, stage == ResidualFrontEnd::Stage::kReady ? d : nan_.data());
+  }
+  void on_ready(std::size_t k) {
+    if (!scan_.on_ready_sample()) return;
+    const std::size_t n = scan_.look_length();
+    ring_.copy_last(n, snapshot_);
+    const auto rows = static_cast<Eigen::Index>(n), m = static_cast<Eigen::Index>(plant_.n_inputs());
+    const diagnosis::Result result =
+        diagnose_window(plant_, nominal_, snapshot_.topLeftCorner(rows, m),
+                        snapshot_.block(0, m, rows, static_cast<Eigen::Index>(plant_.n_outputs())), scan_.alpha_look());
+    scan_.conclude(flagged_outputs(result, plant_.n_outputs()), [&](std::size_t j, bool raised) {
+      msg::Diagnosis d;
+      std::optional<std::size_t> input;
+      double lr = 0.0;
+      if (const diagnosis::Finding* f = raised ? finding_for(result, j) : nullptr) {
+        describe_finding(plant_, *f, d);
+        input = finding_input(*f, j);
+        lr = f->lr;
+      } else {
+        d.text = "no finding on " + plant_.outputs[j] + " in " + std::to_string(scan_.settings().clear_after) +
+                 " looks in a row";
+      }
+      print_scan_event(plant_, k, j, raised, d, input, lr, n, scan_.alpha_look());
+    });
+  }
+
+ private:
+  const PlantModel& plant_;
+  std::vector<std::optional<DiscreteTf>> nominal_;
+  DiagnosisScan scan_;
+  SampleRing ring_;
+  Eigen::MatrixXd snapshot_;
+  std::vector<double> nan_;
+};
+
 int run(int argc, char** argv) {
   try {
     const Args args(argc, argv, with_limit_flags({"plant", "data", "ar-order", "input-order", "input-pole", "forgetting",
                                                   "false-alarm", "threads", "false-alarms-per-year", "crossing-constant",
-                                                  "settle-samples", "channel"}),
+                                                  "settle-samples", "channel", "scan-interval",
+                                                  "diagnosis-window"}),
                     {"json", "events", "plain-lags", "help"});
     if (args.flag("help")) {
       std::fputs(kUsage, stdout);
@@ -173,13 +253,24 @@ int run(int argc, char** argv) {
     if (const std::string e = settings.validate(); !e.empty()) throw UsageError(e);
     const int requested_threads = args.integer("threads", 0);  // 0: one per core
     if (args.get("threads") && requested_threads < 1) throw UsageError("--threads must be >= 1");
+    // The diagnosis scan takes its share of the stated rate from the
+    // sequential detector (share_rate) as in mpmd, so that the table's
+    // 'first raised' is mpmd's sequential detector; it runs with --events.
+    const bool events = args.flag("events");
+    ScanSettings scan;
+    scan.interval = static_cast<std::size_t>(std::max(0, args.integer("scan-interval", 500)));
+    scan.window = static_cast<std::size_t>(std::max(0, args.integer("diagnosis-window", 3000)));
+    scan.min_samples = std::min(scan.min_samples, scan.window);
+    if (const std::string e = scan.validate(); !e.empty()) throw UsageError(e);
+    const double scan_rate = share_rate(settings.detector, scan, plant.sample_time);
+    std::optional<ScanReplay> replay;
+    if (events && scan.interval > 0) replay.emplace(plant, scan, scan_rate);
     const int settle = args.integer("settle-samples", -1);  // -1: settle_length's automatic rule
     if (settle < -1) throw UsageError("--settle-samples must be >= 0 (or -1: automatic)");
 
     std::vector<ChannelTrace> trace(plant.n_inputs() * plant.n_outputs());
     AlarmEdges edges(plant.n_outputs(), plant.n_inputs());
     // On each part's thread: only its outputs, so the parts write disjoint traces.
-    const bool events = args.flag("events");
     if (events && requested_threads > 1) throw UsageError("--events needs one thread (events in sample order)");
     const PartSampleCallback on_sample = [&](std::size_t k, const GrangerMonitor& m) {
       edges.scan(m, m.first_modelled_output(), m.end_modelled_output(), [&](std::size_t j, std::size_t i, bool now) {
@@ -188,6 +279,10 @@ int run(int argc, char** argv) {
         if (!now) t.cleared_at = static_cast<long>(k);
         if (events) print_event(plant, m, k, j, i);
       });
+      if (replay) replay->on_ready(k);
+    };
+    const RowCallback on_row = [&](const double* u, const double* d, ResidualFrontEnd::Stage stage) {
+      if (replay) replay->on_row(u, d, stage);
     };
     // By default the recording is streamed (memory independent of its
     // length); --threads N > 1 loads it whole and splits the outputs.
@@ -195,7 +290,7 @@ int run(int argc, char** argv) {
     const GrangerMonitor monitor = [&] {
       if (requested_threads <= 1) {
         const auto open = [&] { return open_data(args.required("data"), plant, data_options); };
-        StreamedRecord r = monitor_csv_stream(plant, open, settings, args.flag("plain-lags"), on_sample, settle);
+        StreamedRecord r = monitor_csv_stream(plant, open, settings, args.flag("plain-lags"), on_sample, settle, on_row);
         if (!r.notes.empty()) std::fprintf(stderr, "mpm monitor: %s\n", r.notes.c_str());
         samples = r.samples;
         transient = r.transient;

@@ -31,10 +31,15 @@ struct StreamedRecord {
 
 // Opens the recording again for each pass (daemon/data_input.hpp open_data).
 using RowSourceOpener = std::function<std::unique_ptr<config::RowSource>()>;
+// Called for every row once the front end knows u0, before the monitor's
+// update: absolute inputs, residual and where the row stands (the rows mpmd
+// keeps in its diagnosis ring: the settling ones with a NaN residual).
+using RowCallback = std::function<void(const double* u, const double* residual, ResidualFrontEnd::Stage)>;
 
 inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const RowSourceOpener& open,
                                          const MonitorSettings& settings, bool plain_lags,
-                                         const PartSampleCallback& on_sample, int settle_samples = -1) {
+                                         const PartSampleCallback& on_sample, int settle_samples = -1,
+                                         const RowCallback& on_row = {}) {
   // Column indices and names as bind() gives them (its time check runs on
   // the rows below, with the same message).
   config::Recording header;
@@ -96,7 +101,9 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const RowSourc
       y[j] = row[bound.outputs[j]];
       sim_y[j] = bound.sim[j] ? row[*bound.sim[j]] : 0.0;
     }
-    if (front.step(u.data(), y.data(), sim_y.data(), d.data()) != ResidualFrontEnd::Stage::kReady) continue;
+    const ResidualFrontEnd::Stage stage = front.step(u.data(), y.data(), sim_y.data(), d.data());
+    if (on_row && stage != ResidualFrontEnd::Stage::kNoOrigin) on_row(u.data(), d.data(), stage);
+    if (stage != ResidualFrontEnd::Stage::kReady) continue;
     out.monitor.update(u.data(), d.data());
     if (on_sample) on_sample(k, out.monitor);
   }

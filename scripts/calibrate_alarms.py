@@ -2,10 +2,13 @@
 """Full calibration of the live alarm path (issue 11): no-mismatch closed loops
 of Wood-Berry, the 3x3 and the quadruple tank (mpm simulate --scenario
 plant-nominal), each replayed through the live monitor (mpm monitor --events,
-mpmd's forgetting 0.999) at a stated rate high enough to observe (default one
-false alarm per 2e4 samples per controller). Prints, per plant and in all,
-raises against the stated count with a 95 % Poisson interval, and the split
-between the first and second half of the runs (flat in time).
+mpmd's forgetting 0.999; both live detectors: the sequential detector and the
+periodic diagnosis scan, which share the stated rate half and half) at a stated
+rate high enough to observe (default one false alarm per 2e4 samples per
+controller). Prints, per plant and in all, raises against the stated count with
+a 95 % Poisson interval, the raises of each detector, and the split between the
+first and second half of the runs (flat in time). --partial FILE rewrites the
+table there after every run (a long run that is stopped still leaves its figures).
 
 usage: scripts/calibrate_alarms.py [--mpm build/daemon/mpm] [--runs 500]
                                    [--samples 10000] [--per-alarm 2e4] [--seed 1]
@@ -55,15 +58,19 @@ def main():
     ap.add_argument("--samples", type=int, default=10000)
     ap.add_argument("--per-alarm", type=float, default=2e4, help="stated samples per false alarm")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--plants", default=",".join(PLANTS), help="comma-separated plant files in config/")
+    ap.add_argument("--partial", help="rewrite the table in this file after every run")
     args = ap.parse_args()
-    rows, total = [], {"raises": 0, "samples": 0, "first": 0}
+    plants = args.plants.split(",")
+    rows = []
     with tempfile.TemporaryDirectory() as tmp:
         csv = os.path.join(tmp, "run.csv")
-        for p_index, plant_file in enumerate(PLANTS):
+        for p_index, plant_file in enumerate(plants):
             plant = os.path.join(root, "config", plant_file)
             rate = SECONDS_PER_YEAR / (args.per_alarm * sample_time(plant))
-            runs = args.runs // len(PLANTS) + (1 if p_index < args.runs % len(PLANTS) else 0)
-            raises = first = monitored = 0
+            runs = args.runs // len(plants) + (1 if p_index < args.runs % len(plants) else 0)
+            raises = first = monitored = by_scan = 0
+            rows.append(None)
             for r in range(runs):
                 seed = args.seed + 1000 * p_index + r
                 subprocess.run([args.mpm, "simulate", "--scenario", "plant-nominal", "--plant", plant, "--samples",
@@ -82,20 +89,30 @@ def main():
                     e = json.loads(line)
                     if e["event"] == "raised":
                         raises += 1
+                        by_scan += e.get("detector") == "scan"
                         first += e["sample"] < args.samples / 2
                 os.unlink(csv)
+                rows[-1] = (plant_file, r + 1, monitored, raises, first, by_scan)
                 print(f"\r{plant_file}: run {r + 1}/{runs}, {raises} raises", end="", file=sys.stderr, flush=True)
+                if args.partial:
+                    with open(args.partial, "w") as f:
+                        f.write(table(rows, args) + "\n")
             print(file=sys.stderr)
-            rows.append((plant_file, runs, monitored, raises, first))
-            total["raises"] += raises
-            total["samples"] += monitored
-            total["first"] += first
-    print(f"stated: one false alarm per {args.per_alarm:g} samples per controller; {args.samples} samples per run")
-    print(f"{'plant':22s} {'runs':>5s} {'samples':>10s} {'raises':>7s} {'stated':>8s} {'ratio':>6s} {'95% CI':>13s} {'1st/2nd half':>13s}")
-    for name, runs, n, k, first in rows + [("all", sum(r[1] for r in rows), total["samples"], total["raises"], total["first"])]:
-        expected = n / args.per_alarm
+    print(table(rows, args))
+
+
+def table(rows, args):
+    rows = [r for r in rows if r]
+    lines = [f"stated: one false alarm per {args.per_alarm:g} samples per controller; {args.samples} samples per run",
+             f"{'plant':22s} {'runs':>5s} {'samples':>10s} {'raises':>7s} {'scan':>5s} {'stated':>8s} {'ratio':>6s} "
+             f"{'95% CI':>13s} {'1st/2nd half':>13s}"]
+    total = ("all",) + tuple(sum(r[c] for r in rows) for c in range(1, 6))
+    for name, runs, n, k, first, scan in rows + [total]:
+        expected = max(n, 1) / args.per_alarm
         lo, hi = poisson_interval(k)
-        print(f"{name:22s} {runs:5d} {n:10d} {k:7d} {expected:8.1f} {k / expected:6.2f} {lo / expected:6.2f}-{hi / expected:<6.2f} {first:6d}/{k - first:<6d}")
+        lines.append(f"{name:22s} {runs:5d} {n:10d} {k:7d} {scan:5d} {expected:8.1f} {k / expected:6.2f} "
+                     f"{lo / expected:6.2f}-{hi / expected:<6.2f} {first:6d}/{k - first:<6d}")
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

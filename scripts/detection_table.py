@@ -2,7 +2,9 @@
 """Detection table (issue 11): every shared case in DATA/*/ (plant.yaml,
 run.csv, truth.json) replayed whole through the live path (mpm monitor
 --events with mpmd's defaults: forgetting 0.999, one false alarm per year)
-beside mpm diagnose's offline verdict. Prints per case: the truth, the
+beside mpm diagnose's offline verdict. Live = both detectors: the
+sequential detector (per channel) and the periodic diagnosis scan (per
+output, with its physics word); each raise is tagged seq or scan. Prints per case: the truth, the
 offline verdict (mismatched outputs), the live raises (output, channel,
 sample of the first raise) and whether live agrees.
 
@@ -16,8 +18,9 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--mpm", default=os.path.join(root, "build", "daemon", "mpm"))
     ap.add_argument("--data", default="/work/shared/data")
+    ap.add_argument("--live-args", default="", help="extra mpm monitor options, e.g. '--diagnosis-window 10000'")
     args = ap.parse_args()
-    print(f"{'case':38s} {'truth':18s} {'offline':14s} {'live raises (output/channel@sample)':44s} agree")
+    print(f"{'case':38s} {'truth':18s} {'offline':14s} {'live raises (output/channel@sample(detector))':60s} agree")
     tally = {"flagged": 0, "raised_all": 0, "raised_any": 0, "wrong_output": 0, "nominal": 0, "nominal_raised": 0}
     ratios = []
     for case in sorted(glob.glob(os.path.join(args.data, "*", "truth.json"))):
@@ -33,12 +36,13 @@ def main():
             offline = [l["output"] for l in diag["loops"] if l.get("mismatch")]
         except (ValueError, KeyError):
             offline = ["error"]
-        ev = subprocess.run([args.mpm, "monitor", "--plant", plant, "--data", run, "--forgetting", "0.999", "--events"],
+        ev = subprocess.run([args.mpm, "monitor", "--plant", plant, "--data", run, "--forgetting", "0.999", "--events"] + args.live_args.split(),
                             capture_output=True, text=True)
         raises = [json.loads(l) for l in ev.stdout.splitlines() if '"raised"' in l]
         first = {}
         for e in raises:
-            first.setdefault(e["output"], f"{e['output']}/{e['channel']}@{e['sample']}")
+            tag = "scan:" + str(e.get("physics")) if e.get("detector") == "scan" else "seq"
+            first.setdefault(e["output"], f"{e['output']}/{e['channel']}@{e['sample']}({tag})")
         live_outputs = sorted(first)
         if t is None:
             agree = "n/a"
@@ -62,7 +66,7 @@ def main():
             tally["nominal"] += 1
             tally["nominal_raised"] += bool(live_outputs)
         truth_text = ("none" if t is False else "unknown" if t is None else ",".join(true_channels) or "yes")
-        print(f"{name:38s} {truth_text[:18]:18s} {','.join(offline) or 'none':14s} {' '.join(first.values()) or 'none':44s} {agree}",
+        print(f"{name:38s} {truth_text[:18]:18s} {','.join(offline) or 'none':14s} {' '.join(first.values()) or 'none':60s} {agree}",
               flush=True)
     ratios.sort()
     print(f"\nmismatch cases flagged by offline: {tally['flagged']}; raised live on every flagged output: "

@@ -9,38 +9,16 @@
 #include "core/diagnosis.hpp"
 #include "daemon/mpmd/log.hpp"
 #include "daemon/offline.hpp"
+#include "daemon/scan_look.hpp"
 
 namespace mpm {
-namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string channel_text(const PlantModel& plant, const diagnosis::Channel& c) {
-  return (c.input ? plant.inputs[*c.input] : std::string("(no input)")) + " -> " + plant.outputs[c.output];
-}
-
-// The finding that explains the raised output best: one on the raised
-// channel, else one on the raised output, else none.
-const diagnosis::Finding* finding_for(const diagnosis::Result& result, std::size_t output, std::size_t input) {
-  const diagnosis::Finding* on_output = nullptr;
-  for (const auto& f : result.findings) {
-    for (const auto& c : f.channels) {
-      if (c.output != output) continue;
-      if (c.input && *c.input == input) return &f;
-      if (on_output == nullptr) on_output = &f;
-    }
-  }
-  return on_output;
-}
-
-}  // namespace
 
 DiagnosisWorker::DiagnosisWorker(const PlantModel& plant, std::size_t window)
     : plant_(plant),
       nominal_(channel_models(plant)),
       window_(window),
-      ring_(Eigen::MatrixXd::Constant(static_cast<Eigen::Index>(window), static_cast<Eigen::Index>(plant.n_inputs() + plant.n_outputs()), kNaN)),
-      snapshot_(ring_.rows(), ring_.cols()) {}
+      ring_(window, plant.n_inputs(), plant.n_outputs()),
+      snapshot_(static_cast<Eigen::Index>(window), static_cast<Eigen::Index>(plant.n_inputs() + plant.n_outputs())) {}
 
 DiagnosisWorker::~DiagnosisWorker() {
   {
@@ -51,19 +29,15 @@ DiagnosisWorker::~DiagnosisWorker() {
   if (thread_.joinable()) thread_.join();
 }
 
-void DiagnosisWorker::record(const double* u, const double* residual) noexcept {
-  if (window_ == 0) return;
-  const auto row = static_cast<Eigen::Index>(head_);
-  const std::size_t m = plant_.n_inputs();
-  for (std::size_t i = 0; i < m; ++i) ring_(row, static_cast<Eigen::Index>(i)) = u[i];
-  for (std::size_t j = 0; j < plant_.n_outputs(); ++j) ring_(row, static_cast<Eigen::Index>(m + j)) = residual[j];
-  head_ = head_ + 1 == window_ ? 0 : head_ + 1;
-  if (filled_ < window_) ++filled_;
+void DiagnosisWorker::record(const double* u, const double* residual) noexcept { ring_.record(u, residual); }
+
+void DiagnosisWorker::start_locked() {
+  if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
 }
 
 bool DiagnosisWorker::request(Request r) {
   std::lock_guard lock(mutex_);
-  if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
+  start_locked();
   if (busy_) {
     ++coalesced_;
     const bool replaced = pending_.has_value();
@@ -75,14 +49,23 @@ bool DiagnosisWorker::request(Request r) {
 }
 
 void DiagnosisWorker::submit_locked(const Request& r) {
-  // Oldest first: rows head_.. then 0..head_ (when the ring has wrapped).
-  const auto n = static_cast<Eigen::Index>(filled_);
-  const auto start = static_cast<Eigen::Index>(filled_ < window_ ? 0 : head_);
-  for (Eigen::Index k = 0; k < n; ++k) snapshot_.row(k) = ring_.row((start + k) % static_cast<Eigen::Index>(window_));
-  snapshot_rows_ = filled_;
+  ring_.copy_last(ring_.filled(), snapshot_);
+  snapshot_rows_ = ring_.filled();
   job_ = r;
   busy_ = true;
   wake_.notify_all();
+}
+
+bool DiagnosisWorker::look(const Look& look) {
+  std::lock_guard lock(mutex_);
+  if (busy_ || pending_) return false;
+  start_locked();
+  snapshot_rows_ = std::min(look.rows, ring_.filled());
+  ring_.copy_last(snapshot_rows_, snapshot_);
+  look_job_ = look;
+  busy_ = true;
+  wake_.notify_all();
+  return true;
 }
 
 bool DiagnosisWorker::take(msg::Diagnosis& out) {
@@ -97,40 +80,94 @@ bool DiagnosisWorker::take(msg::Diagnosis& out) {
   return true;
 }
 
+bool DiagnosisWorker::idle() const {
+  std::lock_guard lock(mutex_);
+  return !busy_ && !pending_ && !result_ && !look_result_;
+}
+
+bool DiagnosisWorker::take_look(LookResult& out) {
+  std::lock_guard lock(mutex_);
+  if (!look_result_) return false;
+  out = std::move(*look_result_);
+  look_result_.reset();
+  return true;
+}
+
 void DiagnosisWorker::run() {
   const auto m = static_cast<Eigen::Index>(plant_.n_inputs());
   const auto p = static_cast<Eigen::Index>(plant_.n_outputs());
   for (;;) {
-    Request r;
+    std::optional<Request> r;
+    std::optional<Look> l;
     Eigen::MatrixXd u, residual;
     {
       std::unique_lock lock(mutex_);
-      wake_.wait(lock, [&] { return stop_ || job_.has_value(); });
+      wake_.wait(lock, [&] { return stop_ || job_.has_value() || look_job_.has_value(); });
       if (stop_) return;
-      r = std::move(*job_);
-      job_.reset();
+      r.swap(job_);
+      l.swap(look_job_);
       const auto n = static_cast<Eigen::Index>(snapshot_rows_);
       u = snapshot_.topLeftCorner(n, m);
       residual = snapshot_.block(0, m, n, p);
     }
-    msg::Diagnosis d;
     const auto started = std::chrono::steady_clock::now();
+    const auto seconds = [&] {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    };
+    if (l) {
+      LookResult out;
+      try {
+        out = run_look(plant_, nominal_, u, residual, *l);
+      } catch (const std::exception& e) {  // a bad window must not end the service
+        out.look = *l;
+        out.flagged.assign(plant_.n_outputs(), false);
+        out.error = e.what();
+        log::write(log::Level::kError, "diagnosis scan look at sample %lld failed: %s",
+                   static_cast<long long>(l->seq), e.what());
+      }
+      std::lock_guard lock(mutex_);
+      look_result_ = std::move(out);
+      busy_ = false;
+      continue;
+    }
+    msg::Diagnosis d;
     try {
-      d = diagnose(plant_, nominal_, u, residual, r);
+      d = diagnose(plant_, nominal_, u, residual, *r);
     } catch (const std::exception& e) {  // a bad window must not end the service
-      d.controller_id = r.controller_id;
-      d.output = plant_.outputs[r.output];
-      d.input = plant_.inputs[r.input];
+      d.controller_id = r->controller_id;
+      d.output = plant_.outputs[r->output];
+      d.input = plant_.inputs[r->input];
       d.text = std::string("diagnosis failed: ") + e.what();
     }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     log::write(log::Level::kNotice, "controller '%s': diagnosis of %s -> %s over %d samples (%.2f s): %s",
-               d.controller_id.c_str(), d.input.c_str(), d.output.c_str(), d.window, seconds, d.text.c_str());
+               d.controller_id.c_str(), d.input.c_str(), d.output.c_str(), d.window, seconds(), d.text.c_str());
     std::lock_guard lock(mutex_);
     result_ = std::move(d);
     busy_ = false;
     completed_.fetch_add(1);
   }
+}
+
+DiagnosisWorker::LookResult DiagnosisWorker::run_look(const PlantModel& plant,
+                                                      const std::vector<std::optional<DiscreteTf>>& nominal,
+                                                      const Eigen::MatrixXd& u, const Eigen::MatrixXd& residual,
+                                                      const Look& look) {
+  LookResult out;
+  out.look = look;
+  const std::size_t p = plant.n_outputs();
+  const diagnosis::Result result = diagnose_window(plant, nominal, u, residual, look.alpha);
+  out.flagged = flagged_outputs(result, p);
+  out.findings.resize(p);
+  out.inputs.resize(p);
+  out.lr.assign(p, 0.0);
+  for (std::size_t j = 0; j < p; ++j) {
+    const diagnosis::Finding* f = out.flagged[j] ? finding_for(result, j) : nullptr;
+    if (f == nullptr) continue;
+    describe_finding(plant, *f, out.findings[j]);
+    out.inputs[j] = finding_input(*f, j);
+    out.lr[j] = f->lr;
+  }
+  return out;
 }
 
 msg::Diagnosis DiagnosisWorker::diagnose(const PlantModel& plant, const std::vector<std::optional<DiscreteTf>>& nominal,
@@ -149,15 +186,12 @@ msg::Diagnosis DiagnosisWorker::diagnose(const PlantModel& plant, const std::vec
   // The problem `mpm diagnose` builds from a recording (daemon/offline.hpp),
   // from the window, by the same front end (u0 = the operating point, else
   // the window's first complete input sample; missing inputs hold their
-  // last value).
-  diagnosis::Problem problem = plant_problem(plant, u, residual);
-  problem.nominal = nominal;  // computed once, at setup
-  problem.monitor_flag.assign(plant.n_outputs(), false);
-  problem.monitor_flag[r.output] = true;
-  problem.monitor_located.resize(plant.n_outputs());
-  problem.monitor_located[r.output].push_back(r.input);
-
-  const diagnosis::Result result = diagnosis::diagnose(problem);
+  // last value), with the raise as the monitor's verdict.
+  std::vector<bool> flag(plant.n_outputs(), false);
+  flag[r.output] = true;
+  std::vector<std::vector<std::size_t>> located(plant.n_outputs());
+  located[r.output].push_back(r.input);
+  const diagnosis::Result result = diagnose_window(plant, nominal, u, residual, diagnosis::Settings{}.alpha, flag, located);
   const diagnosis::Finding* f = finding_for(result, r.output, r.input);
   if (f == nullptr) {
     d.text = "no physics hypothesis explains " + d.input + " -> " + d.output + " in the last " +
@@ -165,29 +199,7 @@ msg::Diagnosis DiagnosisWorker::diagnose(const PlantModel& plant, const std::vec
              (result.findings.empty() ? std::string() : " (findings elsewhere: " + result.findings.front().physics + ")");
     return d;
   }
-  d.found = true;
-  d.physics = f->physics;
-  for (std::size_t c = 0; c < f->channels.size(); ++c) {
-    d.channels += (c ? ", " : "") + channel_text(plant, f->channels[c]);
-  }
-  if (f->nominal && f->fitted) {
-    const double g0 = f->nominal->dc_gain(), g1 = f->fitted->dc_gain();
-    if (std::isfinite(g0) && std::isfinite(g1) && g0 != 0.0) {
-      d.parameter_names.push_back("gain_ratio");
-      d.parameter_values.push_back(g1 / g0);
-    }
-    d.parameter_names.push_back("delay_change");
-    d.parameter_values.push_back(f->fitted->delay - f->nominal->delay);
-  }
-  for (const auto& [name, value] : f->parameters) {
-    d.parameter_names.push_back(name);
-    d.parameter_values.push_back(value);
-  }
-  const double before = f->fit.holdout_variance_before, after = f->fit.holdout_variance_after;
-  d.holdout_improvement = before > 0.0 ? 1.0 - after / before : 0.0;
-  char tail[96];
-  std::snprintf(tail, sizeof tail, " (held-out prediction error %.1f %% lower)", 100.0 * d.holdout_improvement);
-  d.text = f->summary + tail;
+  describe_finding(plant, *f, d);
   return d;
 }
 

@@ -46,6 +46,24 @@ struct Suppressed {
   char text[64];
 };
 
+// The scan as `mpm monitor --events` runs it: over the diagnosis window,
+// every scan_interval usable samples.
+ScanSettings scan_settings(const ServiceSettings& s) {
+  ScanSettings scan;
+  scan.window = static_cast<std::size_t>(std::max(0, s.diagnosis_window));
+  scan.interval = s.diagnosis_window > 0 ? static_cast<std::size_t>(std::max(0, s.scan_interval)) : 0;
+  scan.min_samples = std::min(scan.min_samples, scan.window);
+  return scan;
+}
+
+// The monitor's settings with the sequential detector's share of the rate.
+MonitorSettings sequential_share(const PlantModel& plant, const ServiceSettings& s) {
+  MonitorSettings m = s.monitor;
+  if (const std::string e = scan_settings(s).validate(); !e.empty()) throw std::invalid_argument(e);
+  share_rate(m.detector, scan_settings(s), plant.sample_time);
+  return m;
+}
+
 }  // namespace
 
 MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& settings, AlarmSink on_alarm)
@@ -53,7 +71,7 @@ MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& s
       settings_(settings),
       on_alarm_(std::move(on_alarm)),
       // The same monitor and front end as `mpm monitor` builds offline.
-      monitor_(MonitorBlueprint(plant, settings.monitor, settings.plain_lags).build()),
+      monitor_(MonitorBlueprint(plant, sequential_share(plant, settings), settings.plain_lags).build()),
       front_(plant, settle_length(plant, settings.settle_samples, kLiveSettleCap)),
       tracker_(settings.max_sequence_jump),
       residual_(plant.n_outputs(), 0.0),
@@ -63,6 +81,9 @@ MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& s
       physics_(plant.n_inputs() * plant.n_outputs()) {
   if (settings.diagnosis_window > 0) {
     diagnosis_ = std::make_unique<DiagnosisWorker>(plant, static_cast<std::size_t>(settings.diagnosis_window));
+    const ScanSettings scan = scan_settings(settings);
+    DetectorSettings whole = settings.monitor.detector;
+    scan_ = DiagnosisScan(plant.n_outputs(), scan, share_rate(whole, scan, plant.sample_time));
   }
   const auto interval = seconds(settings.log_interval);
   const double auto_stale = std::max(60.0, 10.0 * plant.sample_time);
@@ -124,6 +145,57 @@ void MonitorService::on_sample(const msg::Sample& s, Clock::time_point now) {
   }
   step(s.u.data(), s.y.data(), s.sim_y.empty() ? nullptr : s.sim_y.data());
   check_alarms(s);
+  if (look_due_) start_look(s);
+}
+
+// A checkpoint of the scan: the last samples to the diagnosis thread, or the
+// look skipped (counted) while it is busy: nothing waits for it.
+void MonitorService::start_look(const msg::Sample& s) {
+  look_due_ = false;
+  const std::int64_t utime = s.utime != 0 ? s.utime : unix_micros();
+  if (diagnosis_->look({scan_.look_length(), scan_.alpha_look(), utime, s.seq})) return;
+  scan_.skip();
+  log::write(log::Level::kWarning,
+             "controller '%s': diagnosis scan look at sample %" PRId64 " skipped: the diagnosis thread is busy "
+             "(%" PRIu64 " skipped so far)",
+             settings_.controller_id.c_str(), s.seq, scan_.skipped());
+}
+
+void MonitorService::publish_scan_alarm(std::size_t output, bool raised) {
+  const DiagnosisWorker::LookResult& r = look_result_;
+  // The finding's input on the output (-1: none, e.g. a disturbance model).
+  const long input = raised && r.inputs[output] ? static_cast<long>(*r.inputs[output]) : -1;
+  alarm_.controller_id = settings_.controller_id;
+  alarm_.utime = r.look.utime;
+  alarm_.sample_sequence = r.look.seq;
+  alarm_.output = plant_.outputs[output];
+  alarm_.input = input >= 0 ? plant_.inputs[static_cast<std::size_t>(input)] : std::string();
+  alarm_.output_index = static_cast<std::int32_t>(output);
+  alarm_.input_index = static_cast<std::int32_t>(input);
+  alarm_.raised = raised;
+  alarm_.f = kNaN;
+  alarm_.p_value = r.look.alpha;  // the look's level
+  alarm_.gamma = kNaN;
+  if (raised) {
+    diagnosis_msg_ = r.findings[output];
+    diagnosis_msg_.controller_id = settings_.controller_id;
+    diagnosis_msg_.utime = r.look.utime;
+    diagnosis_msg_.sample_sequence = r.look.seq;
+    diagnosis_msg_.output = alarm_.output;
+    diagnosis_msg_.input = alarm_.input;
+    diagnosis_msg_.output_index = alarm_.output_index;
+    diagnosis_msg_.input_index = alarm_.input_index;
+    diagnosis_msg_.window = static_cast<std::int32_t>(r.look.rows);
+    alarm_.physics = diagnosis_msg_.physics;
+    alarm_.text = "diagnosis scan: raised " + alarm_.output + ": " + diagnosis_msg_.text;
+  } else {
+    alarm_.physics.clear();
+    alarm_.text = "diagnosis scan: cleared " + alarm_.output + ": no finding on it in " +
+                  std::to_string(scan_.settings().clear_after) + " looks in a row";
+  }
+  log::write(raised ? log::Level::kWarning : log::Level::kNotice, "controller '%s': %s",
+             settings_.controller_id.c_str(), alarm_.text.c_str());
+  if (on_alarm_) on_alarm_(alarm_);
 }
 
 bool MonitorService::sized_right(const msg::Sample& s) const noexcept {
@@ -144,12 +216,14 @@ void MonitorService::step(const double* u, const double* y, const double* sim_y)
       return;  // no operating point yet: waits for a complete input sample
     case ResidualFrontEnd::Stage::kSettling:
       if (diagnosis_) diagnosis_->record(u, nan_y_.data());  // the transient is not evidence
+      scan_.restart();  // the scan's window grows from the first settled sample
       return;
     case ResidualFrontEnd::Stage::kReady:
       break;
   }
   if (diagnosis_) diagnosis_->record(u, residual_.data());
   monitor_.update(u, residual_.data());
+  if (scan_.on_ready_sample()) look_due_ = true;
 }
 
 void MonitorService::check_alarms(const msg::Sample& s) {
@@ -197,6 +271,21 @@ void MonitorService::republish_raised(const std::string& reason) {
 
 void MonitorService::retire(const std::string& reason) {
   const std::size_t n_in = plant_.n_inputs();
+  // The scan's raised outputs too (their state is not carried over).
+  for (std::size_t j = 0; j < plant_.n_outputs() && scan_.enabled(); ++j) {
+    if (!scan_.raised(j)) continue;
+    scan_.lower(j);
+    fill_alarm_header(j, 0, 0, tracker_.last());
+    alarm_.input.clear();
+    alarm_.input_index = -1;
+    alarm_.raised = false;
+    alarm_.f = alarm_.gamma = kNaN;
+    alarm_.p_value = scan_.alpha_look();
+    alarm_.physics.clear();
+    alarm_.text = "diagnosis scan: cleared " + alarm_.output + ": no longer watched by this monitor (" + reason + ")";
+    log::write(log::Level::kNotice, "controller '%s': %s", settings_.controller_id.c_str(), alarm_.text.c_str());
+    if (on_alarm_) on_alarm_(alarm_);
+  }
   for (std::size_t j = 0; j < plant_.n_outputs(); ++j) {
     for (std::size_t i = 0; i < n_in; ++i) {
       if (!edges_.raised(j, i)) continue;
@@ -399,7 +488,7 @@ void MonitorService::fill_status(msg::Status& out, std::int64_t utime, std::int6
     lo.residual_variance = l.residual_variance;
     lo.sigma1 = l.sigma1;
     lo.sigma_full = l.sigma_full;
-    lo.alarm = l.alarm;
+    lo.alarm = l.alarm || (scan_.enabled() && scan_.raised(j));
     lo.diverging = l.diverging;
   }
   out.alarms_raised = raised;

@@ -13,7 +13,10 @@
 // (core/monitor_front_end.hpp: u0, y - sim_y when the sample carries the
 // controller's prediction, else y - G_M (u - u0), settling) -> monitor
 // update -> alarm edges (AlarmEdges, alarm_facts: what `mpm monitor
-// --events` prints). Every anomaly is counted for the status and logged
+// --events` prints) -> at a checkpoint of the diagnosis scan
+// (core/diagnosis_scan.hpp), the last samples handed to the diagnosis
+// thread, or the look skipped and counted when it is busy; its raises and
+// clears are published between samples (poll_diagnoses). Every anomaly is counted for the status and logged
 // through a Throttle (first at once, then at most once per log interval).
 //
 // Allocation: setup allocates; on_sample allocates nothing in steady state.
@@ -58,6 +61,12 @@ struct ServiceSettings {
   // Samples kept for the diagnosis of a raised output (diagnosis_worker.hpp);
   // 0 = no diagnosis.
   int diagnosis_window = 0;
+  // Usable samples between looks of the diagnosis scan over the last
+  // diagnosis_window samples (needs diagnosis_window > 0); 0 = no scan. The
+  // scan takes its share of monitor.detector.false_alarms_per_year
+  // (share_rate). `mpm monitor --scan-interval`. Off here (unit tests of
+  // the sequential path); mpmd's configuration turns it on (500).
+  int scan_interval = 0;
 };
 
 struct ServiceCounters {
@@ -121,6 +130,9 @@ class MonitorService {
   // Main thread, between samples: hands over a pending diagnosis request and
   // passes each finished diagnosis to `publish`; the physics it names goes
   // into the channel's later alarm messages (the clear, a resume).
+  // A finished look of the diagnosis scan publishes its raises and clears
+  // as alarms (text "diagnosis scan: ...") and each raise's finding as a
+  // diagnosis message.
   template <class Publish>
   void poll_diagnoses(Publish&& publish) {
     if (!diagnosis_) return;
@@ -129,7 +141,14 @@ class MonitorService {
                                          static_cast<std::size_t>(diagnosis_msg_.input_index)] = diagnosis_msg_.physics;
       publish(diagnosis_msg_);
     }
+    while (diagnosis_->take_look(look_result_)) {
+      scan_.conclude(look_result_.flagged, [&](std::size_t j, bool raised) {
+        publish_scan_alarm(j, raised);
+        if (raised) publish(diagnosis_msg_);
+      });
+    }
   }
+  const DiagnosisScan& scan() const noexcept { return scan_; }
   const DiagnosisWorker* diagnosis() const noexcept { return diagnosis_.get(); }
 
   // Publishes a "raised" alarm again for every channel raised now, saying
@@ -155,6 +174,10 @@ class MonitorService {
   void step(const double* u, const double* y, const double* sim_y) noexcept;
   void check_alarms(const msg::Sample& s);
   void publish_alarm(std::size_t output, std::size_t input, const msg::Sample& s);
+  // A raise or clear of an output by the scan's last look (look_result_);
+  // a raise leaves its finding's diagnosis message in diagnosis_msg_.
+  void publish_scan_alarm(std::size_t output, bool raised);
+  void start_look(const msg::Sample& s);
   void fill_alarm_header(std::size_t output, std::size_t input, std::int64_t utime, std::int64_t seq);
   // The header and the channel's whole-record F, p and gamma, stamped with
   // the last sequence number (a republished or retired alarm).
@@ -182,6 +205,9 @@ class MonitorService {
   std::unique_ptr<DiagnosisWorker> diagnosis_;  // null when diagnosis_window = 0
   std::vector<std::string> physics_;           // per channel: the last diagnosis' physics word
   msg::Diagnosis diagnosis_msg_;
+  DiagnosisScan scan_;                         // off without diagnosis_
+  bool look_due_ = false;                      // a checkpoint passed in this sample's steps
+  DiagnosisWorker::LookResult look_result_;
 
   struct Throttles {
     Throttle foreign, gap, duplicate, out_of_order, restart, jump, malformed, nan, dropped, receive_errors;

@@ -63,6 +63,7 @@ std::unique_ptr<MonitorService> make_service(const LoadedConfig& loaded, Monitor
   settings.max_sequence_jump = loaded.config.max_sequence_jump;
   settings.stale_after = loaded.config.stale_after;
   settings.diagnosis_window = loaded.config.diagnosis_window;
+  settings.scan_interval = loaded.config.scan_interval;
   try {
     return std::make_unique<MonitorService>(loaded.plant, settings, std::move(on_alarm));
   } catch (const std::exception& e) {

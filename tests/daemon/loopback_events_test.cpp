@@ -6,9 +6,15 @@
 // monitor --events` and published sample by sample into mpmd over the
 // transport; the alarms mpmd publishes must be the same events: sample,
 // output, channel, raised or cleared, and the numbers (statistic, threshold,
-// F, p, gamma) to 1e-9 relative.
+// F, p, gamma) to 1e-9 relative. Both detectors run (mpmd's defaults): the
+// sequential detector's events in order; the diagnosis scan's (published by
+// mpmd when its diagnosis thread finishes a look, so possibly after later
+// sequential alarms) compared as a set keyed by sample and output, with the
+// channel, the physics word and the look's level.
 #include <cmath>
 #include <fstream>
+#include <map>
+#include <tuple>
 #include <sstream>
 
 #include "config/plant_loader.hpp"
@@ -25,7 +31,7 @@ constexpr int kSamples = 3000;
 struct Event {
   bool raised = false;
   std::int64_t sample = 0;
-  std::string output, channel;
+  std::string output, channel, detector, physics;
   double statistic = 0, threshold = 0, f = 0, p = 0, gamma = 0;
 };
 
@@ -43,7 +49,7 @@ std::string json_value(const std::string& line, const std::string& key) {
   return line.substr(begin, end - begin);
 }
 
-double number(const std::string& text) { return text == "null" ? std::nan("") : std::stod(text); }
+double number(const std::string& text) { return text == "null" || text.empty() ? std::nan("") : std::stod(text); }
 
 std::vector<Event> read_events(const std::string& text) {
   std::vector<Event> out;
@@ -59,6 +65,8 @@ std::vector<Event> read_events(const std::string& text) {
     e.f = number(json_value(line, "F_conditional"));
     e.p = number(json_value(line, "p_value"));
     e.gamma = number(json_value(line, "gamma"));
+    e.detector = json_value(line, "detector");
+    e.physics = json_value(line, "physics");
     out.push_back(e);
   }
   return out;
@@ -135,10 +143,30 @@ TEST_P(EventsTest, MonitorEventsAreExactlyTheAlarmsMpmdPublishes) {
   const int statuses = obs.status_count("wb");
   ASSERT_TRUE(eventually([&] { return obs.status_count("wb") >= statuses + 2; }, std::chrono::seconds(10)));
 
-  const std::vector<msg::Alarm> alarms = obs.alarms();
-  ASSERT_EQ(alarms.size(), events.size()) << monitor.stdout_text();
-  for (std::size_t n = 0; n < events.size(); ++n) {
-    const Event& e = events[n];
+  ASSERT_EQ(obs.alarms().size(), events.size()) << monitor.stdout_text();
+  // The scan's events, as a set keyed by (sample, output, raised).
+  std::vector<msg::Alarm> alarms, scan_alarms;
+  for (const msg::Alarm& a : obs.alarms()) (a.text.rfind("diagnosis scan:", 0) == 0 ? scan_alarms : alarms).push_back(a);
+  std::map<std::tuple<std::int64_t, std::string, bool>, Event> scan_events;
+  std::vector<Event> sequential;
+  for (const Event& e : events) {
+    if (e.detector == "scan") scan_events[{e.sample, e.output, e.raised}] = e;
+    else sequential.push_back(e);
+  }
+  EXPECT_FALSE(scan_events.empty()) << "the scan must raise the scenario too";
+  ASSERT_EQ(scan_alarms.size(), scan_events.size()) << monitor.stdout_text();
+  for (const msg::Alarm& a : scan_alarms) {
+    SCOPED_TRACE(a.text);
+    const auto it = scan_events.find({a.sample_sequence, a.output, a.raised});
+    ASSERT_NE(it, scan_events.end());
+    const Event& e = it->second;
+    EXPECT_EQ(a.input, e.channel == "null" ? "" : e.channel);
+    EXPECT_EQ(a.physics, e.raised ? e.physics : "");
+    EXPECT_TRUE(close(a.p_value, e.p));  // the look's level
+  }
+  ASSERT_EQ(alarms.size(), sequential.size()) << monitor.stdout_text();
+  for (std::size_t n = 0; n < sequential.size(); ++n) {
+    const Event& e = sequential[n];
     const msg::Alarm& a = alarms[n];
     SCOPED_TRACE("event " + std::to_string(n) + ": " + a.text);
     EXPECT_EQ(a.controller_id, "wb");
