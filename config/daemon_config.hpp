@@ -34,7 +34,7 @@
 
 #include "config/limits.hpp"
 #include "core/granger_monitor.hpp"
-#include "transport/transport_settings.hpp"
+#include "settings/transport_settings.hpp"
 
 namespace mpm::config {
 

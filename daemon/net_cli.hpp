@@ -10,7 +10,7 @@
 
 #include "config/daemon_config.hpp"
 #include "daemon/args.hpp"
-#include "transport/transport_settings.hpp"
+#include "settings/transport_settings.hpp"
 
 namespace mpm::net_cli {
 
