@@ -37,15 +37,8 @@ constexpr const char* kUsage =
     "  --ar-order N, --input-order N  as in mpmd.yaml (default 10, 10)\n";
 
 int run(int argc, char** argv) {
-  try {
-    const Args args(argc, argv,
-                    {"plant", "runs", "samples", "seed", "out", "false-alarms-per-year", "forgetting", "ar-order",
-                     "input-order"},
-                    {"help"});
-    if (args.flag("help")) {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
+  return run_command("mpm calibrate", kUsage, argc, argv, {"plant", "runs", "samples", "seed", "out", "false-alarms-per-year", "forgetting", "ar-order",
+                     "input-order"}, {}, [&](const Args& args) {
     const std::string plant_path = args.required("plant");
     const PlantModel plant = config::load_plant(plant_path);
     MonitorSettings settings;
@@ -131,13 +124,7 @@ int run(int argc, char** argv) {
       if (!f.flush()) throw std::runtime_error("cannot write " + out);
     }
     return 0;
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm calibrate: %s\n%s", e.what(), kUsage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm calibrate: %s\n", e.what());
-    return 1;
-  }
+  });
 }
 
 const bool registered = register_command({"calibrate", "detector thresholds for a plant by Monte Carlo under no mismatch", &run});

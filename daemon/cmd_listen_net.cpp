@@ -83,13 +83,8 @@ int run(int argc, char** argv) {
   bool samples = false;
   bool diagnoses = false;
   double timeout_s = 0;
-  try {
-    const Args args(argc, argv, net_cli::valued_options({"controller", "count", "timeout"}),
-                    {"alarms-only", "samples", "diagnoses", "help"});
-    if (args.flag("help")) {
-      std::printf("%s%s", kUsage, net_cli::kOptionsHelp);
-      return 0;
-    }
+  const std::string usage = std::string(kUsage) + net_cli::kOptionsHelp;
+  return run_command("mpm listen", usage.c_str(), argc, argv, net_cli::valued_options({"controller", "count", "timeout"}), {"alarms-only", "samples", "diagnoses"}, [&](const Args& args) {
     net = net_cli::read(args);
     filter.controller = args.get("controller").value_or("");
     filter.alarms_only = args.flag("alarms-only");
@@ -98,22 +93,16 @@ int run(int argc, char** argv) {
     diagnoses = args.flag("diagnoses");
     timeout_s = args.number("timeout", 0);
     if (filter.count < 0 || timeout_s < 0) throw UsageError("--count and --timeout must not be negative");
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm listen: %s\n%s%s", e.what(), kUsage, net_cli::kOptionsHelp);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm listen: %s\n", e.what());
-    return 1;
-  }
-  std::string error;
-  auto t = transport::create(net.transport, error);
-  if (!t) {
-    std::fprintf(stderr, "mpm listen: %s\n", error.c_str());
-    return 1;
-  }
-  signal(SIGINT, on_stop);
-  signal(SIGTERM, on_stop);
-  return listen(*t, filter, samples, diagnoses, timeout_s);
+    std::string error;
+    auto t = transport::create(net.transport, error);
+    if (!t) {
+      std::fprintf(stderr, "mpm listen: %s\n", error.c_str());
+      return 1;
+    }
+    signal(SIGINT, on_stop);
+    signal(SIGTERM, on_stop);
+    return listen(*t, filter, samples, diagnoses, timeout_s);
+  });
 }
 
 const bool registered =

@@ -117,15 +117,9 @@ std::int64_t random_session() {
 int run(int argc, char** argv) {
   net_cli::NetOptions net;
   ReplayOptions o;
-  try {
-    const Args args(argc, argv,
-                    net_cli::valued_options({"data", "plant", "rate", "controller", "session", "first-seq",
-                                             "wait-readers"}),
-                    {"as-fast-as-possible", "help"});
-    if (args.flag("help")) {
-      std::printf("%s%s", kUsage, net_cli::kOptionsHelp);
-      return 0;
-    }
+  const std::string usage = std::string(kUsage) + net_cli::kOptionsHelp;
+  return run_command("mpm replay", usage.c_str(), argc, argv, net_cli::valued_options({"data", "plant", "rate", "controller", "session", "first-seq",
+                                             "wait-readers"}), {"as-fast-as-possible"}, [&](const Args& args) {
     net = net_cli::read(args);
     o.data = args.required("data");
     o.plant = args.get("plant").value_or(net.daemon ? net.daemon->plant_path : "");
@@ -135,14 +129,6 @@ int run(int argc, char** argv) {
     o.session = args.get("session") ? static_cast<std::int64_t>(args.number("session", 0)) : random_session();
     o.first_seq = static_cast<std::int64_t>(args.number("first-seq", 1));
     o.wait_readers = args.number("wait-readers", 10);
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm replay: %s\n%s%s", e.what(), kUsage, net_cli::kOptionsHelp);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm replay: %s\n", e.what());
-    return 1;
-  }
-  try {
     const PlantModel plant = config::load_plant(o.plant);
     const config::Recording rec = config::load_recording(o.data);
     if (o.controller.empty()) o.controller = plant.name;
@@ -154,10 +140,7 @@ int run(int argc, char** argv) {
     signal(SIGINT, on_stop);
     signal(SIGTERM, on_stop);
     return replay(*t, plant, rec, o);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm replay: %s\n", e.what());
-    return 1;
-  }
+  });
 }
 
 const bool registered =

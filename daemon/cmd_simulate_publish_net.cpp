@@ -88,21 +88,15 @@ int publish_loop(transport::Transport& t, sim::ClosedLoop& loop, const Options& 
 int run(int argc, char** argv) {
   net_cli::NetOptions net;
   Options o;
-  try {
-    const Args args(argc, argv,
-                    net_cli::valued_options({"scenario", "publish", "plant", "samples", "seed", "rate", "controller",
-                                             "wait-readers"}),
-                    {"as-fast-as-possible", "help"});
-    if (args.flag("help")) {
-      std::printf("%s%s", kUsage, net_cli::kOptionsHelp);
-      return 0;
-    }
+  const std::string usage = std::string(kUsage) + net_cli::kOptionsHelp;
+  return run_command("mpm simulate-live", usage.c_str(), argc, argv, net_cli::valued_options({"scenario", "publish", "plant", "samples", "seed", "rate", "controller",
+                                             "wait-readers"}), {"as-fast-as-possible"}, [&](const Args& args) {
     net = net_cli::read(args);
     o.scenario = args.required("scenario");
-    const sim::Scenario* scenario = sim::find_scenario(o.scenario);
-    if (!scenario) throw UsageError("unknown scenario '" + o.scenario + "' (mpm simulate --list)");
+    const sim::Scenario* found = sim::find_scenario(o.scenario);
+    if (!found) throw UsageError("unknown scenario '" + o.scenario + "' (mpm simulate --list)");
     o.plant = args.get("plant");
-    if (scenario->plant_file.empty() && !o.plant)
+    if (found->plant_file.empty() && !o.plant)
       throw UsageError("scenario " + o.scenario + " needs --plant FILE: it is tuned from the plant file given");
     o.controller = args.get("controller").value_or(net.daemon ? net.daemon->controller_id : "");
     o.samples = args.integer("samples", 0);
@@ -110,15 +104,7 @@ int run(int argc, char** argv) {
     o.rate = net_cli::read_rate(args);
     if (o.samples < 0) throw UsageError("--samples must not be negative");
     o.wait_readers = args.number("wait-readers", 10);
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm simulate-live: %s\n%s%s", e.what(), kUsage, net_cli::kOptionsHelp);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm simulate-live: %s\n", e.what());
-    return 1;
-  }
-  try {
-    const sim::Scenario& scenario = *sim::find_scenario(o.scenario);
+    const sim::Scenario& scenario = *found;
     const sim::ResolvedPlant plant =
         o.plant ? sim::ResolvedPlant{config::load_plant(*o.plant), *o.plant} : sim::default_plant(scenario);
     if (o.controller.empty()) o.controller = plant.model.name;
@@ -130,10 +116,7 @@ int run(int argc, char** argv) {
     signal(SIGINT, on_stop);
     signal(SIGTERM, on_stop);
     return publish_loop(*t, loop, o);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm simulate-live: %s\n", e.what());
-    return 1;
-  }
+  });
 }
 
 const bool registered = register_command(
