@@ -24,6 +24,15 @@ std::string flag_of(const FieldRow<S>& row) {
   return flag;
 }
 
+// The rows named `keys`, in table order (a command that takes some settings).
+template <class S>
+std::vector<FieldRow<S>> only(const std::vector<FieldRow<S>>& rows, const std::set<std::string>& keys) {
+  std::vector<FieldRow<S>> out;
+  for (const FieldRow<S>& row : rows)
+    if (keys.count(row.key)) out.push_back(row);
+  return out;
+}
+
 // `valued` plus one flag per row.
 template <class S>
 std::set<std::string> with_flags(const std::vector<FieldRow<S>>& rows, std::set<std::string> valued) {
