@@ -1,8 +1,6 @@
 // `mpm listen`: prints the monitors' alarms and status as JSON lines, the way
 // an operator (or a test, or jq) watches them.
-#include <signal.h>
 
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -26,9 +24,6 @@ constexpr const char* kUsage =
     "  --controller ID       only messages of this controller\n"
     "  --count N             exit after N lines (exit 1 if the timeout comes first)\n"
     "  --timeout SECONDS     exit after this long (0 = never, the default)\n";
-
-std::atomic<bool> g_stop{false};
-void on_stop(int) { g_stop = true; }
 
 struct Filter {
   std::string controller;
@@ -67,9 +62,9 @@ int listen(transport::Transport& t, Filter& filter, bool samples, bool diagnoses
     });
   }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (!g_stop && !filter.done()) {
+  while (!net_cli::g_stop && !filter.done()) {
     if (timeout_s > 0 && std::chrono::steady_clock::now() >= deadline) break;
-    if (t.handle(std::chrono::milliseconds(100)) < 0 && !g_stop) {
+    if (t.handle(std::chrono::milliseconds(100)) < 0 && !net_cli::g_stop) {
       std::fprintf(stderr, "mpm listen: the transport failed\n");
       return 1;
     }
@@ -99,8 +94,7 @@ int run(int argc, char** argv) {
       std::fprintf(stderr, "mpm listen: %s\n", error.c_str());
       return 1;
     }
-    signal(SIGINT, on_stop);
-    signal(SIGTERM, on_stop);
+    net_cli::stop_on_signals();
     return listen(*t, filter, samples, diagnoses, timeout_s);
   });
 }

@@ -1,9 +1,7 @@
 // `mpm simulate-live`: runs a closed-loop scenario live and publishes every
 // sample on LCM or DDS, as the MPC of a real plant would: a demo source for
 // mpmd that needs no recording.
-#include <signal.h>
 
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <random>
@@ -28,14 +26,7 @@ constexpr const char* kUsage =
     "options:\n"
     "  --plant FILE           nominal model (default: the scenario's)\n"
     "  --samples N            samples to publish (default 0: until interrupted)\n"
-    "  --seed S               random seed (default 1)\n"
-    "  --rate HZ              samples per second (default: 1 / the plant's sample_time)\n"
-    "  --as-fast-as-possible  no pacing\n"
-    "  --controller ID        controller id (default: the config's, else the plant's name)\n"
-    "  --wait-readers SECONDS DDS: wait this long for a subscriber first (default 10)\n";
-
-std::atomic<bool> g_stop{false};
-void on_stop(int) { g_stop = true; }
+    "  --seed S               random seed (default 1)\n";
 
 std::int64_t unix_micros() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -68,7 +59,7 @@ int publish_loop(transport::Transport& t, sim::ClosedLoop& loop, const Options& 
   }
   const auto start = std::chrono::steady_clock::now();
   long sent = 0;
-  for (long k = 0; !g_stop && (o.samples == 0 || k < o.samples); ++k) {
+  for (long k = 0; !net_cli::g_stop && (o.samples == 0 || k < o.samples); ++k) {
     if (rate > 0) std::this_thread::sleep_until(start + std::chrono::duration<double>(static_cast<double>(k) / rate));
     const sim::LoopSample& x = loop.step();
     loop.fill_row(x, row.data());
@@ -88,7 +79,7 @@ int publish_loop(transport::Transport& t, sim::ClosedLoop& loop, const Options& 
 int run(int argc, char** argv) {
   net_cli::NetOptions net;
   Options o;
-  const std::string usage = std::string(kUsage) + net_cli::kOptionsHelp;
+  const std::string usage = std::string(kUsage) + net_cli::kPublisherHelp + net_cli::kOptionsHelp;
   return run_command("mpm simulate-live", usage.c_str(), argc, argv, net_cli::valued_options({"scenario", "publish", "plant", "samples", "seed", "rate", "controller",
                                              "wait-readers"}), {"as-fast-as-possible"}, [&](const Args& args) {
     net = net_cli::read(args);
@@ -113,8 +104,7 @@ int run(int argc, char** argv) {
     auto t = transport::create(net.transport, error);
     if (!t) throw std::runtime_error(error);
     t->advertise(transport::Transport::Topic::kSample);
-    signal(SIGINT, on_stop);
-    signal(SIGTERM, on_stop);
+    net_cli::stop_on_signals();
     return publish_loop(*t, loop, o);
   });
 }
