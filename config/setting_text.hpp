@@ -57,8 +57,9 @@ std::string set_from_text(const FieldRow<S>& row, S& s, const std::string& text)
             return std::string(std::is_same_v<T, double> ? "expected a number" : "expected an integer") + ", got \"" +
                    text + "\"";
           if constexpr (!std::is_same_v<T, double>) {  // a whole number that fits T
+            // (max + 1.0 rounds to 2^63 and 2^64 for the 64-bit types: strictly below it fits)
             if (v != std::floor(v) || v < static_cast<double>(std::numeric_limits<T>::lowest()) ||
-                v > static_cast<double>(std::numeric_limits<T>::max()))
+                !(v < static_cast<double>(std::numeric_limits<T>::max()) + 1.0))
               return "expected an integer, got \"" + text + "\"";
           }
           if (!row.range.contains(v))

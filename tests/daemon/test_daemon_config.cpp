@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
 #include <variant>
 
 #include "child_process.hpp"
 #include "config/daemon_config.hpp"
 #include "config/file_text.hpp"
+#include "config/setting_text.hpp"
 #include "config/settings_doc.hpp"
 #include "config/plant_loader.hpp"
 
@@ -143,6 +145,36 @@ TEST(DaemonConfig, ErrorsNameTheirField) {
   s.diagnosis_window = 0;  // its "off" value, outside its range
   s.stale_after = -1;      // "auto"
   EXPECT_EQ(s.errors().size(), 2u);
+}
+
+// A file's scalar and a flag's text are read by one function (setting_text.hpp):
+// words, bools, whole numbers that must fit their type, ranges.
+TEST(DaemonConfig, SettingTextIsCheckedBeforeItIsStored) {
+  const auto row = [](const char* key) {
+    for (const auto& r : config::ServiceSettings::monitor_fields())
+      if (std::string(r.key) == key) return r;
+    throw std::runtime_error(key);
+  };
+  config::ServiceSettings s;
+  EXPECT_EQ(config::set_from_text(row("settle_samples"), s, "50"), "");
+  EXPECT_EQ(s.settle_samples, 50);
+  EXPECT_EQ(config::set_from_text(row("settle_samples"), s, "auto"), "");
+  EXPECT_EQ(s.settle_samples, -1);
+  EXPECT_EQ(config::set_from_text(row("input_pole"), s, "auto"), "");
+  EXPECT_TRUE(s.input_pole_auto);
+  EXPECT_EQ(config::set_from_text(row("regressors"), s, "plain_lags"), "");
+  EXPECT_TRUE(s.plain_lags);
+  EXPECT_NE(config::set_from_text(row("regressors"), s, "lags"), "");
+  EXPECT_NE(config::set_from_text(row("warmup"), s, "1e30").find("expected an integer"), std::string::npos);
+  EXPECT_NE(config::set_from_text(row("ar_order"), s, "4.5"), "");
+  EXPECT_NE(config::set_from_text(row("forgetting"), s, "0.5").find("forgetting must be in (0.9, 1]"),
+            std::string::npos);
+  EXPECT_NE(config::set_from_text(row("forgetting"), s, "nan"), "");
+  EXPECT_EQ(config::set_from_text(row("detector_thresholds"), s, "50,51.5"), "");
+  EXPECT_EQ(s.monitor.detector.thresholds, (std::vector<double>{50, 51.5}));
+  const config::ServiceSettings unchanged = s;
+  EXPECT_NE(config::set_from_text(row("ar_order"), s, "300"), "");
+  EXPECT_TRUE(s == unchanged) << "a refused value is not stored";
 }
 
 // One value of a number row other than its default, inside its range.
