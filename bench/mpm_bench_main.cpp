@@ -87,12 +87,7 @@ int print_soak(const mpm::bench::SoakReport& r) {
 
 int main(int argc, char** argv) {
   using namespace mpm;
-  try {
-    const Args args(argc, argv, {"soak", "seed"}, {"json", "quick", "help"});
-    if (args.flag("help")) {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
+  return run_command("mpm bench", kUsage, argc, argv, {"soak", "seed"}, {"json", "quick"}, [](const Args& args) {
     if (args.get("soak")) {
 #ifdef MPM_BENCH_HAVE_SOAK
       const double n = args.number("soak", 0.0);
@@ -119,11 +114,5 @@ int main(int argc, char** argv) {
     const std::string out = args.flag("json") ? bench::to_json(machine, figures) : bench::to_table(machine, figures);
     std::fputs(out.c_str(), stdout);
     return 0;
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm bench: %s\n%s", e.what(), kUsage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm bench: %s\n", e.what());
-    return 1;
-  }
+  });
 }

@@ -104,6 +104,7 @@ ServiceSettings soak_settings() {
   s.monitor.detector.windows = 2;
   s.settle_samples = 100;
   s.log_interval = 3600;
+  s.diagnosis_window = 0;  // the monitor's own memory and time, without the diagnosis
   return s;
 }
 

@@ -1,10 +1,11 @@
 #include "config/daemon_config.hpp"
 
-#include <cmath>
 #include <filesystem>
+#include <variant>
 
 #include "config/file_text.hpp"
 #include "config/plant_loader.hpp"
+#include "config/setting_text.hpp"
 #include "config/strict_modes.hpp"
 #include "config/yaml_reader.hpp"
 
@@ -38,60 +39,48 @@ void read(const YamlReader& r, const Field& map, const char* key, int& out) {
   const Field f = r.child(map, key);
   if (f.present()) out = r.integer(f);
 }
-void read(const YamlReader& r, const Field& map, const char* key, double& out) {
-  const Field f = r.child(map, key);
-  if (f.present()) out = r.number(f);
-}
 void read(const YamlReader& r, const Field& map, const char* key, std::string& out) {
   const Field f = r.child(map, key);
   if (f.present()) out = r.name(f);
 }
 
+// One row's value, when its key is present: a list of numbers, or a scalar
+// read as a flag's text would be (setting_text.hpp).
+template <class S>
+void read_row(const YamlReader& r, const Field& map, const FieldRow<S>& row, S& s) {
+  const Field f = r.child(map, row.key);
+  if (!f.present()) return;
+  const auto ref = row.ref(s);
+  if (auto* list = std::get_if<std::vector<double>*>(&ref)) {
+    // [] states the default (an empty list: none) in the example file
+    **list = f.node.IsSequence() && f.node.size() == 0 ? std::vector<double>{} : r.numbers(f);
+    return;
+  }
+  if (!f.node.IsScalar()) r.fail_expected(f, "a single value");
+  if (const std::string problem = set_from_text(row, s, f.node.Scalar()); !problem.empty()) r.fail(f, problem);
+}
+
+// The keys of a map the rows name (for check_keys), plus `more`.
+template <class S>
+std::vector<std::string> keys_of(const std::vector<FieldRow<S>>& rows, std::vector<std::string> more = {}) {
+  for (const FieldRow<S>& row : rows) more.emplace_back(row.key);
+  return more;
+}
+
+// Errors of settings read from `map`: each at its key when the file has it.
+void fail_at_key(const YamlReader& r, const Field& map, const std::vector<FieldError>& errors) {
+  if (errors.empty()) return;
+  const Field at = r.child(map, errors.front().field);
+  r.fail(at.present() ? at : map, errors.front().message);
+}
+
 void read_monitor(const YamlReader& r, const Field& root, DaemonConfig& c) {
   const Field m = r.child(root, "monitor");
   if (!m.present() || m.node.IsNull()) return;
-  r.check_keys(m, {"ar_order", "input_order", "forgetting", "false_alarm", "false_alarms_per_year", "sample_time",
-                   "crossing_constant", "detector_thresholds", "outlier_limit", "warmup", "gamma_lambda", "input_pole", "regressors",
-                   "settle_samples"});
-  MonitorSettings& s = c.monitor;
-  read(r, m, "ar_order", s.ar_order);
-  read(r, m, "input_order", s.input_order);
-  read(r, m, "forgetting", s.forgetting);
-  read(r, m, "false_alarm", s.false_alarm);
-  read(r, m, "false_alarms_per_year", s.detector.false_alarms_per_year);
-  read(r, m, "sample_time", s.detector.sample_time);
-  read(r, m, "crossing_constant", s.detector.crossing_constant);
-  read(r, m, "outlier_limit", s.outlier_limit);
-  if (const Field t = r.child(m, "detector_thresholds"); t.present()) s.detector.thresholds = r.numbers(t);
-  read(r, m, "warmup", s.warmup);
-  read(r, m, "gamma_lambda", s.gamma_lambda);
-  const Field pole = r.child(m, "input_pole");
-  if (pole.present() && pole.node.IsScalar() && pole.node.Scalar() == "auto") {
-    c.input_pole_auto = true;
-  } else {
-    read(r, m, "input_pole", s.input_pole);
-  }
-  const Field regressors = r.child(m, "regressors");
-  if (regressors.present()) {
-    const std::string kind = r.name(regressors);
-    if (kind != "model_filtered" && kind != "plain_lags")
-      r.fail(regressors, "expected model_filtered or plain_lags, got \"" + kind + "\"");
-    c.plain_lags = kind == "plain_lags";
-  }
-  const Field settle = r.child(m, "settle_samples");
-  if (settle.present() && !(settle.node.IsScalar() && settle.node.Scalar() == "auto")) {
-    c.settle_samples = r.integer(settle);
-    if (c.settle_samples < 0) r.fail(settle, "expected \"auto\" or a number of samples >= 0");
-  }
-  // validate() names the field first ("forgetting must be in ..."): point at
-  // that key when the file has it.
-  if (const std::string problem = s.validate(); !problem.empty()) {
-    for (const auto& kv : m.node) {
-      const std::string key = kv.first.Scalar();
-      if (problem.rfind(key + " ", 0) == 0) r.fail(r.child(m, key), problem);
-    }
-    r.fail(m, problem);
-  }
+  const auto& rows = ServiceSettings::monitor_fields();
+  r.check_keys(m, keys_of(rows));
+  for (const auto& row : rows) read_row<ServiceSettings>(r, m, row, c);
+  fail_at_key(r, m, c.monitor.errors());  // what the settings break together (the detector's)
 }
 
 void read_lcm(const YamlReader& r, const Field& t, transport::LcmSettings& lcm) {
@@ -138,39 +127,11 @@ void read_transport(const YamlReader& r, const Field& root, const std::string& b
   read_dds(r, t, base_dir, c.transport.dds);
 }
 
-void read_service(const YamlReader& r, const Field& root, DaemonConfig& c) {
-  read(r, root, "status_period", c.status_period);
-  if (c.status_period < 0.01 || c.status_period > 3600)
-    r.fail(r.child(root, "status_period"), "expected seconds in 0.01..3600");
-  read(r, root, "queue_capacity", c.queue_capacity);
-  if (c.queue_capacity < 2 || c.queue_capacity > (1 << 20))
-    r.fail(r.child(root, "queue_capacity"), "expected a number of samples in 2..1048576");
-  read(r, root, "log_interval", c.log_interval);
-  if (c.log_interval < 0) r.fail(r.child(root, "log_interval"), "expected seconds >= 0");
-  if (const Field jump = r.child(root, "max_sequence_jump"); jump.present()) {
-    const double n = r.number(jump);
-    if (!(n >= 1 && n <= 1e15 && n == std::floor(n))) r.fail(jump, "expected a number of samples in 1..1e15");
-    c.max_sequence_jump = static_cast<std::int64_t>(n);
-  }
-  const Field stale = r.child(root, "stale_after");
-  if (stale.present() && !(stale.node.IsScalar() && stale.node.Scalar() == "auto")) {
-    read(r, root, "stale_after", c.stale_after);
-    if (!(c.stale_after >= 0)) r.fail(stale, "expected \"auto\" or seconds >= 0 (0 = never)");
-  }
-}
-
-void read_checkpoint(const YamlReader& r, const Field& root, const std::string& base_dir, DaemonConfig& c) {
-  read(r, root, "checkpoint_path", c.checkpoint_path);
+// The top-level keys of ServiceSettings and DaemonConfig.
+void read_top_level(const YamlReader& r, const Field& root, const std::string& base_dir, DaemonConfig& c) {
+  for (const auto& row : ServiceSettings::fields()) read_row<ServiceSettings>(r, root, row, c);
+  for (const auto& row : DaemonConfig::fields()) read_row(r, root, row, c);
   if (!c.checkpoint_path.empty()) c.checkpoint_path = resolve(c.checkpoint_path, base_dir);
-  read(r, root, "checkpoint_interval", c.checkpoint_interval);
-  if (!(c.checkpoint_interval >= 0.05 && c.checkpoint_interval <= 86400))
-    r.fail(r.child(root, "checkpoint_interval"), "expected seconds in 0.05..86400");
-  read(r, root, "diagnosis_window", c.diagnosis_window);
-  if (c.diagnosis_window != 0 && (c.diagnosis_window < 200 || c.diagnosis_window > 1000000))
-    r.fail(r.child(root, "diagnosis_window"), "expected 0 (off) or a number of samples in 200..1000000");
-  read(r, root, "scan_interval", c.scan_interval);
-  if (c.scan_interval != 0 && (c.scan_interval < 50 || c.scan_interval > 10000000))
-    r.fail(r.child(root, "scan_interval"), "expected 0 (off) or a number of samples in 50..10000000");
 }
 
 // limits: {max_inputs: 200, ...}: the caps on the plant file (limits.hpp).
@@ -187,6 +148,20 @@ void read_limits(const YamlReader& r, const Field& root, DaemonConfig& c) {
 
 }  // namespace
 
+const std::vector<FieldRow<DaemonConfig>>& DaemonConfig::fields() {
+  using S = DaemonConfig;
+  static const std::vector<FieldRow<S>> rows = {
+      {"status_period", [](S& s) { return &s.status_period; }, {.min = 0.01, .max = 3600}, "seconds between status messages"},
+      {"queue_capacity", [](S& s) { return &s.queue_capacity; }, {.min = 2, .max = 1 << 20, .whole = true},
+       "samples between the receiver thread and the monitor; a full queue drops, counts (`dropped`) and logs"},
+      {"checkpoint_path", [](S& s) { return &s.checkpoint_path; }, {},
+       "file of the monitor's state (relative to this file), written atomically every checkpoint_interval and at SIGTERM, resumed at start when the controller, settings and plant file's text are those it was written with; give each mpmd@ instance its own file"},
+      {"checkpoint_interval", [](S& s) { return &s.checkpoint_interval; }, {.min = 0.05, .max = 86400},
+       "seconds between checkpoints; one more at SIGTERM"},
+  };
+  return rows;
+}
+
 DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string& source_name,
                                  const std::string& base_dir) {
   const YamlReader r(source_name);
@@ -198,9 +173,8 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
   }
   const Field root = r.root(document);
   try {
-    r.check_keys(root, {"controller_id", "plant", "monitor", "transport", "status_period", "queue_capacity",
-                        "log_interval", "max_sequence_jump", "stale_after", "checkpoint_path",
-                        "checkpoint_interval", "diagnosis_window", "scan_interval", "limits"});
+    r.check_keys(root, keys_of(DaemonConfig::fields(), keys_of(ServiceSettings::fields(),
+                                                                {"controller_id", "plant", "monitor", "transport", "limits"})));
     DaemonConfig c;
     c.source = source_name;
     c.controller_id = r.name(r.child(root, "controller_id"));
@@ -209,8 +183,7 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
     if (!file_exists(c.plant_path)) r.fail(plant, "no such plant file: " + c.plant_path);
     read_monitor(r, root, c);
     read_transport(r, root, base_dir, c);
-    read_service(r, root, c);
-    read_checkpoint(r, root, base_dir, c);
+    read_top_level(r, root, base_dir, c);
     read_limits(r, root, c);
     return c;
   } catch (const YAML::Exception& e) {

@@ -6,13 +6,15 @@
 // the allowed range. The defaults cover every plant in the tree with a wide
 // margin; a caller with a bigger plant passes its own Limits, set from the
 // daemon config's `limits:` section or the `--max-...` flags of mpm
-// (limit_rows(): one row per cap, read by both).
+// (Limits::fields(): one row per cap, read by both).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
+
+#include "core/field_table.hpp"
 
 namespace mpm::config {
 
@@ -25,18 +27,13 @@ struct Limits {
   std::uint64_t max_yaml_bytes = 64u << 20;  // a plant or daemon config file
   std::size_t max_csv_columns = 10000;     // columns of a recording's header
   std::uint64_t max_csv_bytes = std::uint64_t{16} << 30;  // a whole recording read at once
-};
 
-// One cap: its key (the daemon config's `limits:` key; the mpm flag is
-// "--" + key with '-' for '_', e.g. --max-delay-samples) and the whole
-// numbers it may be set to.
-struct LimitRow {
-  const char* key;
-  double min;
-  double max;
-  void (*set)(Limits&, double);
+  // One row per cap: its key (the daemon config's `limits:` key; the mpm
+  // flag is "--" + key with '-' for '_', e.g. --max-delay-samples) and the
+  // whole numbers it may be set to.
+  static const std::vector<FieldRow<Limits>>& fields();
+  bool operator==(const Limits&) const = default;
 };
-const std::vector<LimitRow>& limit_rows();
 
 // Sets the cap named `key` to `value`. Returns "" when done, else what is
 // wrong (no such cap, or not a whole number in its range), naming the range.

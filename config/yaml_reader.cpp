@@ -38,7 +38,7 @@ bool is_yaml_non_finite(std::string_view text) {
 
 bool is_extension_key(std::string_view key) { return key.rfind("x-", 0) == 0; }
 
-std::string join(std::initializer_list<std::string_view> words) {
+std::string join(const std::vector<std::string>& words) {
   std::string out;
   for (auto w : words) {
     if (!out.empty()) out += ", ";
@@ -151,8 +151,7 @@ std::vector<std::string> YamlReader::names(const Field& field) const {
   return out;
 }
 
-void YamlReader::check_keys(const Field& map,
-                            std::initializer_list<std::string_view> allowed) const {
+void YamlReader::check_keys(const Field& map, const std::vector<std::string>& allowed) const {
   require_map(map);
   std::map<std::string, int> seen_on_line;
   for (const auto& kv : map.node) {
@@ -165,7 +164,7 @@ void YamlReader::check_keys(const Field& map,
     seen_on_line.emplace(key, kv.first.Mark().line + 1);
     if (is_extension_key(key)) continue;
     bool known = false;
-    for (auto a : allowed) known = known || a == key;
+    for (const auto& a : allowed) known = known || a == key;
     if (!known)
       fail(key_field,
            "unknown key (allowed here: " + join(allowed) + "; extension keys start with \"x-\")");

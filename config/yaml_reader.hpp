@@ -50,7 +50,7 @@ class YamlReader {
 
   // Fails on a key not in `allowed` (keys starting with "x-" are extensions
   // and always allowed) and on a key given twice.
-  void check_keys(const Field& map, std::initializer_list<std::string_view> allowed) const;
+  void check_keys(const Field& map, const std::vector<std::string>& allowed) const;
 
   const std::string& source() const { return source_; }
 

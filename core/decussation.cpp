@@ -74,14 +74,15 @@ DiscreteTf monic_noise_model(DiscreteTf n, std::size_t output) {
 // energy.
 int settling_length(const DiscreteTf& n) {
   DiscreteFilter filter(n);
-  std::vector<double> energy_before(kMaxSettlingLength + 1, 0.0);
-  for (int t = 0; t < kMaxSettlingLength; ++t) {
+  const auto length = static_cast<std::size_t>(kMaxSettlingLength);
+  std::vector<double> energy_before(length + 1, 0.0);
+  for (std::size_t t = 0; t < length; ++t) {
     const double h = filter.step(t == 0 ? 1.0 : 0.0);
     energy_before[t + 1] = energy_before[t] + h * h;
   }
   const double total = energy_before.back();
-  for (int t = 0; t <= kMaxSettlingLength; ++t) {
-    if (total - energy_before[t] <= kSettledTailEnergy * total) return t;
+  for (std::size_t t = 0; t <= length; ++t) {
+    if (total - energy_before[t] <= kSettledTailEnergy * total) return static_cast<int>(t);
   }
   return kMaxSettlingLength;
 }

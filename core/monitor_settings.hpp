@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/sequential_detector.hpp"
 
@@ -32,8 +33,16 @@ struct MonitorSettings {
                                  // 10 x number of regressors)
   double gamma_lambda = 0.1;     // paper's lambda: gamma < lambda^2 locates
 
+  // One row per setting (field_table.hpp), with the detector's settings a
+  // monitor file sets (false_alarms_per_year, sample_time,
+  // crossing_constant, detector_thresholds) lifted from DetectorSettings.
+  static const std::vector<FieldRow<MonitorSettings>>& fields();
+  // Every setting out of its range (each range is in one row), then the
+  // detector's own errors.
+  std::vector<FieldError> errors() const;
   // Empty string when valid, else what is wrong (names the field and range).
-  std::string validate() const;
+  std::string validate() const { return joined(errors()); }
+  bool operator==(const MonitorSettings&) const = default;
 };
 
 // What one update did with a sample.

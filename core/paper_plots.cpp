@@ -65,26 +65,29 @@ OrderSweep order_sweep(const Eigen::VectorXd& d, const Eigen::MatrixXd& u, int m
   gram = gram.selfadjointView<Eigen::Lower>();
   const double n = static_cast<double>(rows.size());
 
-  for (Eigen::Index i = 0; i < m; ++i) {
-    for (int nb = 0; nb <= max_input; ++nb) {
-      for (int na = 1; na <= max_ar; ++na) {
-        std::vector<Eigen::Index> cols;
-        for (int l = 0; l < na; ++l) cols.push_back(l);
-        for (int l = 0; l < nb; ++l) cols.push_back(max_ar + i * max_input + l);
+  const auto n_inputs = static_cast<std::size_t>(m), n_ar = static_cast<std::size_t>(max_ar),
+             n_lags = static_cast<std::size_t>(max_input);
+  for (std::size_t i = 0; i < n_inputs; ++i) {
+    for (std::size_t nb = 0; nb <= n_lags; ++nb) {
+      for (std::size_t na = 1; na <= n_ar; ++na) {
+        std::vector<Eigen::Index> cols;  // d~ lags 1..na, then u_i lags 1..nb
+        for (std::size_t l = 0; l < na; ++l) cols.push_back(static_cast<Eigen::Index>(l));
+        for (std::size_t l = 0; l < nb; ++l) cols.push_back(static_cast<Eigen::Index>(n_ar + i * n_lags + l));
         const auto q = static_cast<Eigen::Index>(cols.size());
         if (n <= static_cast<double>(q + 1)) continue;
         Eigen::MatrixXd gxx(q, q);
         Eigen::VectorXd gxy(q);
-        for (Eigen::Index r = 0; r < q; ++r) {
-          gxy(r) = gram(cols[r], target);
-          for (Eigen::Index c = 0; c < q; ++c) gxx(r, c) = gram(cols[r], cols[c]);
+        for (std::size_t r = 0; r < cols.size(); ++r) {
+          const auto er = static_cast<Eigen::Index>(r);
+          gxy(er) = gram(cols[r], target);
+          for (std::size_t c = 0; c < cols.size(); ++c) gxx(er, static_cast<Eigen::Index>(c)) = gram(cols[r], cols[c]);
         }
         const Eigen::LDLT<Eigen::MatrixXd> ldlt(gxx);
         if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) continue;
         const Eigen::VectorXd beta = ldlt.solve(gxy);
         out.variance[i][nb][na - 1] = std::max(0.0, gram(target, target) - beta.dot(gxy)) / n;
-        if (na == max_ar && nb == max_input)
-          for (int l = 0; l < max_ar; ++l) out.ar[i][l] = beta(l);
+        if (na == n_ar && nb == n_lags)
+          for (std::size_t l = 0; l < n_ar; ++l) out.ar[i][l] = beta(static_cast<Eigen::Index>(l));
       }
     }
   }

@@ -23,24 +23,38 @@ double log_chi_square_density(double h, double dof) noexcept {
 
 }  // namespace
 
-std::string DetectorSettings::validate() const {
-  std::ostringstream e;
-  if (!(false_alarms_per_year > 0.0 && false_alarms_per_year <= 1e9))
-    e << "false_alarms_per_year must be in (0, 1e9], got " << false_alarms_per_year << "; ";
-  if (!(sample_time >= 0.0 && sample_time <= 1e6)) e << "sample_time must be in [0, 1e6] s (0: the plant's), got " << sample_time << "; ";
-  if (windows < 1 || windows > 16) e << "detector windows must be in [1, 16], got " << windows << "; ";
-  if (!(first_window == 0.0 || (first_window >= 2.0 && first_window <= 1e7)))
-    e << "first_window must be 0 (auto) or in [2, 1e7], got " << first_window << "; ";
-  if (!(window_ratio >= 1.5 && window_ratio <= 100.0)) e << "window_ratio must be in [1.5, 100], got " << window_ratio << "; ";
-  if (!(crossing_constant > 0.0 && crossing_constant <= 100.0))
-    e << "crossing_constant must be in (0, 100], got " << crossing_constant << "; ";
-  if (!(clear_fraction >= 0.0 && clear_fraction < 1.0)) e << "clear_fraction must be in [0, 1), got " << clear_fraction << "; ";
+const std::vector<FieldRow<DetectorSettings>>& DetectorSettings::fields() {
+  using S = DetectorSettings;
+  static const std::vector<FieldRow<S>> rows = {
+      {"false_alarms_per_year", [](S& s) { return &s.false_alarms_per_year; }, {.min = 0.0, .max = 1e9, .min_open = true},
+       "live alarms: stated false-alarm rate for the whole controller"},
+      {"sample_time", [](S& s) { return &s.sample_time; }, {.min = 0.0, .max = 1e6},
+       "seconds per sample (0: the plant's)"},
+      {"windows", [](S& s) { return &s.windows; }, {.min = 1, .max = 16, .whole = true}, "detector memories"},
+      {"first_window", [](S& s) { return &s.first_window; }, {.min = 2.0, .max = 1e7, .also = 0.0},
+       "shortest memory in samples (0: 2 / (1 - forgetting))"},
+      {"window_ratio", [](S& s) { return &s.window_ratio; }, {.min = 1.5, .max = 100.0}, "ratio of successive memories"},
+      {"crossing_constant", [](S& s) { return &s.crossing_constant; }, {.min = 0.0, .max = 100.0, .min_open = true},
+       "the detector's crossing-rate constant (from mpm calibrate)"},
+      {"clear_fraction", [](S& s) { return &s.clear_fraction; }, {.min = 0.0, .max = 1.0, .max_open = true},
+       "clear level = d + fraction (h_W - d)"},
+      {"detector_thresholds", [](S& s) { return &s.thresholds; }, {},
+       "one threshold per memory, from mpm calibrate (empty: from the rate)"},
+  };
+  return rows;
+}
+
+std::vector<FieldError> DetectorSettings::errors() const {
+  std::vector<FieldError> e = range_errors(fields(), *this);
   if (!thresholds.empty() && thresholds.size() != static_cast<std::size_t>(windows))
-    e << "detector thresholds: need one per window (" << windows << "), got " << thresholds.size() << "; ";
+    e.push_back({"detector_thresholds", "detector_thresholds: need one per window (" + std::to_string(windows) +
+                                            "), got " + std::to_string(thresholds.size())});
   for (double h : thresholds)
-    if (!(std::isfinite(h) && h > 0.0)) e << "detector thresholds must be finite and > 0, got " << h << "; ";
-  if (rate_per_sample() >= 0.1) e << "false_alarms_per_year x sample_time is more than 0.1 alarms per sample; ";
-  return e.str();
+    if (!(std::isfinite(h) && h > 0.0))
+      e.push_back({"detector_thresholds", "detector_thresholds must be finite and > 0, got " + std::to_string(h)});
+  if (rate_per_sample() >= 0.1)
+    e.push_back({"false_alarms_per_year", "false_alarms_per_year x sample_time is more than 0.1 alarms per sample"});
+  return e;
 }
 
 double DetectorSettings::rate_per_sample() const noexcept {

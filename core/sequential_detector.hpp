@@ -70,6 +70,8 @@
 
 #include <Eigen/Dense>
 
+#include "core/field_table.hpp"
+
 namespace mpm {
 
 // A Cholesky factor of the n x n identity: storage sized at setup and every
@@ -97,7 +99,12 @@ struct DetectorSettings {
   std::vector<double> thresholds;      // per window, from `mpm calibrate`;
                                        // empty = derived from the rate
 
-  std::string validate() const;
+  // One row per setting (field_table.hpp): keys, ranges, help.
+  static const std::vector<FieldRow<DetectorSettings>>& fields();
+  // Every setting out of its range, then what the settings break together.
+  std::vector<FieldError> errors() const;
+  std::string validate() const { return joined(errors()); }  // "" when valid
+  bool operator==(const DetectorSettings&) const = default;
   // Rate per sample for the whole controller.
   double rate_per_sample() const noexcept;
 };

@@ -17,6 +17,7 @@
 #include "daemon/calibration.hpp"
 #include "daemon/command.hpp"
 #include "daemon/offline.hpp"
+#include "daemon/setting_flags.hpp"
 
 namespace mpm {
 namespace {
@@ -32,28 +33,24 @@ constexpr const char* kUsage =
     "  --runs N                   closed-loop runs (default 40)\n"
     "  --samples N                samples per run (default 40000)\n"
     "  --seed S                   first seed (default 1; run r uses S + r)\n"
-    "  --false-alarms-per-year R  stated rate for the whole controller (default 1)\n"
-    "  --forgetting L             monitor forgetting (default 0.999, as mpmd)\n"
-    "  --ar-order N, --input-order N  as in mpmd.yaml (default 10, 10)\n";
+    "monitor settings, as in mpmd.yaml (defaults mpmd's):\n";
+
+// The monitor settings calibrate takes: those its thresholds depend on.
+const std::vector<FieldRow<MonitorSettings>>& setting_rows() {
+  static const auto rows =
+      only(MonitorSettings::fields(), {"ar_order", "input_order", "forgetting", "false_alarms_per_year"});
+  return rows;
+}
 
 int run(int argc, char** argv) {
-  try {
-    const Args args(argc, argv,
-                    {"plant", "runs", "samples", "seed", "out", "false-alarms-per-year", "forgetting", "ar-order",
-                     "input-order"},
-                    {"help"});
-    if (args.flag("help")) {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
+  static const std::string usage = kUsage + flags_usage(setting_rows());
+  return run_command("mpm calibrate", usage.c_str(), argc, argv,
+                     with_flags(setting_rows(), {"plant", "runs", "samples", "seed", "out"}), {},
+                     [&](const Args& args) {
     const std::string plant_path = args.required("plant");
     const PlantModel plant = config::load_plant(plant_path);
     MonitorSettings settings;
-    settings.forgetting = args.number("forgetting", settings.forgetting);
-    settings.ar_order = args.integer("ar-order", settings.ar_order);
-    settings.input_order = args.integer("input-order", settings.input_order);
-    settings.detector.false_alarms_per_year =
-        args.number("false-alarms-per-year", settings.detector.false_alarms_per_year);
+    apply_flags(args, setting_rows(), settings);
     if (const std::string e = settings.validate(); !e.empty()) throw UsageError(e);
     const int runs = args.integer("runs", 40);
     const int samples = args.integer("samples", 40000);
@@ -131,13 +128,7 @@ int run(int argc, char** argv) {
       if (!f.flush()) throw std::runtime_error("cannot write " + out);
     }
     return 0;
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm calibrate: %s\n%s", e.what(), kUsage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm calibrate: %s\n", e.what());
-    return 1;
-  }
+  });
 }
 
 const bool registered = register_command({"calibrate", "detector thresholds for a plant by Monte Carlo under no mismatch", &run});

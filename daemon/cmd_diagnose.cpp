@@ -150,13 +150,7 @@ void write_products(const Args& args, const std::string& plant_path, const std::
 // --- Problem set-up ----------------------------------------------------------
 
 int run(int argc, char** argv) {
-  try {
-    const Args args(argc, argv, with_limit_flags({"plant", "data", "json", "write-plant", "html", "channel"}),
-                    {"help", "quiet", "verbose"});
-    if (args.flag("help")) {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
+  return run_command("mpm diagnose", kUsage, argc, argv, with_limit_flags({"plant", "data", "json", "write-plant", "html", "channel"}), {"quiet", "verbose"}, [&](const Args& args) {
     g_quiet = args.flag("quiet");
     keep_freed_columns_in_heap();
     const std::string plant_path = args.required("plant");
@@ -189,7 +183,7 @@ int run(int argc, char** argv) {
                    "least %llu\n",
                    static_cast<unsigned long long>(monitor.counters().used), rec.samples(),
                    static_cast<unsigned long long>(needed));
-      return 3;
+      return kExitUndecided;
     }
 
     progress("fitting structured hypotheses");
@@ -212,13 +206,7 @@ int run(int argc, char** argv) {
       config::write_stdout(json);
     write_products(args, plant_path, data_path, plant, problem, monitor, verdict, result, trace);
     return 0;
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm diagnose: %s\n%s", e.what(), kUsage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm diagnose: %s\n", e.what());
-    return 1;
-  }
+  });
 }
 
 const bool registered = register_command({"diagnose", "explain the mismatch in a recording (diagnosis JSON)", &run});

@@ -1,8 +1,6 @@
 // `mpm listen`: prints the monitors' alarms and status as JSON lines, the way
 // an operator (or a test, or jq) watches them.
-#include <signal.h>
 
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -26,9 +24,6 @@ constexpr const char* kUsage =
     "  --controller ID       only messages of this controller\n"
     "  --count N             exit after N lines (exit 1 if the timeout comes first)\n"
     "  --timeout SECONDS     exit after this long (0 = never, the default)\n";
-
-std::atomic<bool> g_stop{false};
-void on_stop(int) { g_stop = true; }
 
 struct Filter {
   std::string controller;
@@ -67,9 +62,9 @@ int listen(transport::Transport& t, Filter& filter, bool samples, bool diagnoses
     });
   }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  while (!g_stop && !filter.done()) {
+  while (!net_cli::g_stop && !filter.done()) {
     if (timeout_s > 0 && std::chrono::steady_clock::now() >= deadline) break;
-    if (t.handle(std::chrono::milliseconds(100)) < 0 && !g_stop) {
+    if (t.handle(std::chrono::milliseconds(100)) < 0 && !net_cli::g_stop) {
       std::fprintf(stderr, "mpm listen: the transport failed\n");
       return 1;
     }
@@ -83,13 +78,8 @@ int run(int argc, char** argv) {
   bool samples = false;
   bool diagnoses = false;
   double timeout_s = 0;
-  try {
-    const Args args(argc, argv, net_cli::valued_options({"controller", "count", "timeout"}),
-                    {"alarms-only", "samples", "diagnoses", "help"});
-    if (args.flag("help")) {
-      std::printf("%s%s", kUsage, net_cli::kOptionsHelp);
-      return 0;
-    }
+  const std::string usage = std::string(kUsage) + net_cli::kOptionsHelp;
+  return run_command("mpm listen", usage.c_str(), argc, argv, net_cli::valued_options({"controller", "count", "timeout"}), {"alarms-only", "samples", "diagnoses"}, [&](const Args& args) {
     net = net_cli::read(args);
     filter.controller = args.get("controller").value_or("");
     filter.alarms_only = args.flag("alarms-only");
@@ -98,22 +88,15 @@ int run(int argc, char** argv) {
     diagnoses = args.flag("diagnoses");
     timeout_s = args.number("timeout", 0);
     if (filter.count < 0 || timeout_s < 0) throw UsageError("--count and --timeout must not be negative");
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm listen: %s\n%s%s", e.what(), kUsage, net_cli::kOptionsHelp);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm listen: %s\n", e.what());
-    return 1;
-  }
-  std::string error;
-  auto t = transport::create(net.transport, error);
-  if (!t) {
-    std::fprintf(stderr, "mpm listen: %s\n", error.c_str());
-    return 1;
-  }
-  signal(SIGINT, on_stop);
-  signal(SIGTERM, on_stop);
-  return listen(*t, filter, samples, diagnoses, timeout_s);
+    std::string error;
+    auto t = transport::create(net.transport, error);
+    if (!t) {
+      std::fprintf(stderr, "mpm listen: %s\n", error.c_str());
+      return 1;
+    }
+    net_cli::stop_on_signals();
+    return listen(*t, filter, samples, diagnoses, timeout_s);
+  });
 }
 
 const bool registered =

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "config/plant_loader.hpp"
+#include "config/service_settings.hpp"
 #include "core/chi_square.hpp"
 #include "core/diagnosis_scan.hpp"
 #include "core/granger_monitor.hpp"
@@ -19,12 +20,13 @@
 #include "daemon/limit_flags.hpp"
 #include "daemon/offline.hpp"
 #include "daemon/scan_look.hpp"
+#include "daemon/setting_flags.hpp"
 #include "daemon/stream_monitor.hpp"
 
 namespace mpm {
 namespace {
 
-constexpr const char* kUsage =
+constexpr const char* kUsageHead =
     "usage: mpm monitor --plant PLANT.yaml --data RUN.csv [options]\n"
     "  Replays the recording through the online monitor and prints, per output and input,\n"
     "  the paper's pairwise index F, the conditional index (other inputs in the model),\n"
@@ -32,19 +34,7 @@ constexpr const char* kUsage =
     "  lcm-logger file of the sample channel (told by its content; formats.md 4.4).\n"
     "options:\n"
     "  --channel NAME     the sample channel of an LCM log (default MPM_SAMPLE)\n"
-    "  --ar-order N       residual lags na (default 10)\n"
-    "  --input-order N    input lags nb (default 10)\n"
-    "  --input-pole A|auto  Laguerre pole of the input basis (default 0: plain lags as in\n"
-    "                     the paper; auto = the model's dominant pole: longer memory, but\n"
-    "                     needs records much longer than nb/(1-A) samples to stay calibrated)\n"
-    "  --forgetting L     RLS forgetting factor in (0.9, 1] (default 1: the whole record)\n"
-    "  --false-alarm A    per-channel test level alpha (default 1e-3)\n"
-    "  --plain-lags       regress on plain input lags as in the paper (default: lags of the\n"
-    "                     input filtered through the nominal channel G_ji, where it is nonzero)\n"
-    "  --settle-samples N samples skipped while the nominal model's start-up transient\n"
-    "                     decays (mpmd's settle_samples; default: none when every output has a\n"
-    "                     sim_ column, else the plant's 1 % settling time, at most a tenth of\n"
-    "                     the record)\n"
+    "  --plain-lags       regress on plain input lags as in the paper (= --regressors plain_lags)\n"
     "  --threads N        N > 1: load the whole record and replay parts of the outputs on N\n"
     "                     threads (default: one thread, the record read as a stream, memory\n"
     "                     independent of its length; the result does not depend on it)\n"
@@ -53,17 +43,24 @@ constexpr const char* kUsage =
     "                     alarms mpmd publishes for the same samples and settings (one thread;\n"
     "                     --forgetting 0.999 is mpmd's default memory): the sequential\n"
     "                     detector's per channel, and the diagnosis scan's per output\n"
-    "  --scan-interval N  usable samples between looks of the diagnosis scan (run with --events; mpmd's\n"
-    "                     scan_interval; default 500: the scan has half the stated rate, the\n"
-    "                     sequential detector the other half; 0 = no scan, all to the latter)\n"
-    "  --diagnosis-window N  --events: most recent samples a scan look diagnoses (mpmd's\n"
-    "                     diagnosis_window; default 3000)\n"
-    "  --false-alarms-per-year R  stated false-alarm rate of the live detector for the\n"
-    "                     whole controller (default 1; the sample time is the plant's)\n"
-    "  --crossing-constant C  the detector's crossing-rate constant (from mpm calibrate)\n"
     MPM_LIMIT_FLAGS_USAGE
     "The loop verdict is the end-of-record test (the statistics after the last sample);\n"
-    "'first raised' is the live detector's first raise.\n";
+    "'first raised' is the live detector's first raise.\n"
+    "monitor settings: mpmd.yaml's `monitor:` keys, same names and ranges (default: mpmd's,\n"
+    "except --forgetting 1, the whole record):\n";
+
+// mpmd.yaml's top-level rows of the diagnosis scan, which `--events` replays.
+const std::vector<FieldRow<config::ServiceSettings>>& scan_rows() {
+  static const auto rows = only(config::ServiceSettings::fields(), {"diagnosis_window", "scan_interval"});
+  return rows;
+}
+
+// The usage: the fixed text, then one line per monitor setting (its row).
+const std::string& usage() {
+  static const std::string text =
+      kUsageHead + flags_usage(config::ServiceSettings::monitor_fields()) + flags_usage(scan_rows());
+  return text;
+}
 
 // A JSON number, or null when not finite (JSON has no NaN or infinity).
 std::string num(double v) {
@@ -227,30 +224,21 @@ class ScanReplay {
 };
 
 int run(int argc, char** argv) {
-  try {
-    const Args args(argc, argv, with_limit_flags({"plant", "data", "ar-order", "input-order", "input-pole", "forgetting",
-                                                  "false-alarm", "threads", "false-alarms-per-year", "crossing-constant",
-                                                  "settle-samples", "channel", "scan-interval",
-                                                  "diagnosis-window"}),
-                    {"json", "events", "plain-lags", "help"});
-    if (args.flag("help")) {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-    MonitorSettings settings;
-    settings.ar_order = args.integer("ar-order", settings.ar_order);
-    settings.input_order = args.integer("input-order", settings.input_order);
-    settings.forgetting = args.number("forgetting", kRecordForgetting);
-    settings.false_alarm = args.number("false-alarm", settings.false_alarm);
-    settings.detector.false_alarms_per_year =
-        args.number("false-alarms-per-year", settings.detector.false_alarms_per_year);
-    settings.detector.crossing_constant = args.number("crossing-constant", settings.detector.crossing_constant);
+  const auto valued = with_limit_flags(with_flags(
+      config::ServiceSettings::monitor_fields(), with_flags(scan_rows(), {"plant", "data", "threads", "channel"})));
+  return run_command("mpm monitor", usage().c_str(), argc, argv, valued, {"json", "events", "plain-lags"},
+                     [](const Args& args) {
+    config::ServiceSettings service;
+    service.monitor.forgetting = kRecordForgetting;  // the whole record, unless told
+    service.plain_lags = args.flag("plain-lags");
+    apply_flags(args, config::ServiceSettings::monitor_fields(), service);
+    apply_flags(args, scan_rows(), service);
+    MonitorSettings& settings = service.monitor;
     const config::Limits limits = limits_from(args);
     const PlantModel plant = config::load_plant(args.required("plant"), limits);
     const DataOptions data_options{args.get("channel").value_or("MPM_SAMPLE"), "mpm monitor", limits};
-    const std::string pole = args.get("input-pole").value_or("0");
-    settings.input_pole = pole == "auto" ? dominant_pole(plant) : args.number("input-pole", settings.input_pole);
-    if (const std::string e = settings.validate(); !e.empty()) throw UsageError(e);
+    if (service.input_pole_auto) settings.input_pole = dominant_pole(plant);
+    if (const std::vector<FieldError> e = service.errors(); !e.empty()) throw UsageError(joined(e));
     const int requested_threads = args.integer("threads", 0);  // 0: one per core
     if (args.get("threads") && requested_threads < 1) throw UsageError("--threads must be >= 1");
     // The diagnosis scan takes its share of the stated rate from the
@@ -258,15 +246,14 @@ int run(int argc, char** argv) {
     // 'first raised' is mpmd's sequential detector; it runs with --events.
     const bool events = args.flag("events");
     ScanSettings scan;
-    scan.interval = static_cast<std::size_t>(std::max(0, args.integer("scan-interval", 500)));
-    scan.window = static_cast<std::size_t>(std::max(0, args.integer("diagnosis-window", 3000)));
+    scan.interval = static_cast<std::size_t>(std::max(0, service.scan_interval));
+    scan.window = static_cast<std::size_t>(std::max(0, service.diagnosis_window));
     scan.min_samples = std::min(scan.min_samples, scan.window);
     if (const std::string e = scan.validate(); !e.empty()) throw UsageError(e);
     const double scan_rate = share_rate(settings.detector, scan, plant.sample_time);
     std::optional<ScanReplay> replay;
     if (events && scan.interval > 0) replay.emplace(plant, scan, scan_rate);
-    const int settle = args.integer("settle-samples", -1);  // -1: settle_length's automatic rule
-    if (settle < -1) throw UsageError("--settle-samples must be >= 0 (or -1: automatic)");
+    const int settle = service.settle_samples;  // -1: settle_length's automatic rule
 
     std::vector<ChannelTrace> trace(plant.n_inputs() * plant.n_outputs());
     AlarmEdges edges(plant.n_outputs(), plant.n_inputs());
@@ -290,7 +277,7 @@ int run(int argc, char** argv) {
     const GrangerMonitor monitor = [&] {
       if (requested_threads <= 1) {
         const auto open = [&] { return open_data(args.required("data"), plant, data_options); };
-        StreamedRecord r = monitor_csv_stream(plant, open, settings, args.flag("plain-lags"), on_sample, settle, on_row);
+        StreamedRecord r = monitor_csv_stream(plant, open, settings, service.plain_lags, on_sample, settle, on_row);
         if (!r.notes.empty()) std::fprintf(stderr, "mpm monitor: %s\n", r.notes.c_str());
         samples = r.samples;
         transient = r.transient;
@@ -301,7 +288,7 @@ int run(int argc, char** argv) {
       samples = rec.samples();
       transient = series.transient;
       return monitor_record(plant, series, settings, static_cast<std::size_t>(requested_threads),
-                            args.flag("plain-lags"), on_sample);
+                            service.plain_lags, on_sample);
     }();
     if (events) {
       // the events were the output
@@ -310,14 +297,8 @@ int run(int argc, char** argv) {
     } else {
       print_table(plant, monitor, trace, samples, transient);
     }
-    return 0;
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm monitor: %s\n%s", e.what(), kUsage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm monitor: %s\n", e.what());
-    return 1;
-  }
+    return kExitOk;
+  });
 }
 
 const bool registered = register_command({"monitor", "replay a recording through the online monitor", &run});

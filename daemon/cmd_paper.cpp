@@ -62,12 +62,7 @@ void print_case(const PaperCase& pc, const PaperCaseResult& r) {
 }
 
 int run(int argc, char** argv) {
-  try {
-    const Args args(argc, argv, {"scenario", "samples", "seed", "out", "input-order", "ar-order"}, {"help"});
-    if (args.flag("help")) {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
+  return run_command("mpm paper", kUsage, argc, argv, {"scenario", "samples", "seed", "out", "input-order", "ar-order"}, {}, [&](const Args& args) {
     const int samples_override = args.integer("samples", 0);
     const auto seed = static_cast<std::uint64_t>(args.integer("seed", 1));
     const std::string only = args.get("scenario").value_or("");
@@ -101,13 +96,7 @@ int run(int argc, char** argv) {
                 n - (only.empty() ? 1 : 0));
     config::write_stdout("");  // flushes; a failed write of the report is an error
     return 0;
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm paper: %s\n%s", e.what(), kUsage);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm paper: %s\n", e.what());
-    return 1;
-  }
+  });
 }
 
 const bool registered = register_command({"paper", "reproduce the paper's case studies, beside decussation", &run});

@@ -1,8 +1,6 @@
 // `mpm replay`: publishes a recording sample by sample, as the controller
 // would, on LCM or DDS: the controller's side for tests and demos.
-#include <signal.h>
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -24,15 +22,8 @@ constexpr const char* kUsage =
     "  Publishes the recording's samples (inputs, outputs, sim_<output> when every output has\n"
     "  one, other columns as named extra signals) as the controller would.\n"
     "options:\n"
-    "  --rate HZ              samples per second (default: 1 / the plant's sample_time)\n"
-    "  --as-fast-as-possible  no pacing\n"
-    "  --controller ID        controller id (default: the config's, else the plant's name)\n"
     "  --session N            session id (default: random, i.e. a new publisher run)\n"
-    "  --first-seq N          sequence number of the first sample (default 1)\n"
-    "  --wait-readers SECONDS DDS: wait this long for a subscriber before publishing (default 10)\n";
-
-std::atomic<bool> g_stop{false};
-void on_stop(int) { g_stop = true; }
+    "  --first-seq N          sequence number of the first sample (default 1)\n";
 
 struct ReplayOptions {
   std::string data;
@@ -92,7 +83,7 @@ int replay(transport::Transport& t, const PlantModel& plant, const config::Recor
   s.extra_names = layout.extra_names;
   const auto start = std::chrono::steady_clock::now();
   std::size_t sent = 0, failed = 0;
-  for (Eigen::Index k = 0; k < static_cast<Eigen::Index>(rec.samples()) && !g_stop; ++k) {
+  for (Eigen::Index k = 0; k < static_cast<Eigen::Index>(rec.samples()) && !net_cli::g_stop; ++k) {
     if (o.rate > 0) std::this_thread::sleep_until(start + std::chrono::duration<double>(static_cast<double>(k) / o.rate));
     s.seq = o.first_seq + k;
     s.utime = unix_micros();
@@ -117,15 +108,9 @@ std::int64_t random_session() {
 int run(int argc, char** argv) {
   net_cli::NetOptions net;
   ReplayOptions o;
-  try {
-    const Args args(argc, argv,
-                    net_cli::valued_options({"data", "plant", "rate", "controller", "session", "first-seq",
-                                             "wait-readers"}),
-                    {"as-fast-as-possible", "help"});
-    if (args.flag("help")) {
-      std::printf("%s%s", kUsage, net_cli::kOptionsHelp);
-      return 0;
-    }
+  const std::string usage = std::string(kUsage) + net_cli::kPublisherHelp + net_cli::kOptionsHelp;
+  return run_command("mpm replay", usage.c_str(), argc, argv, net_cli::valued_options({"data", "plant", "rate", "controller", "session", "first-seq",
+                                             "wait-readers"}), {"as-fast-as-possible"}, [&](const Args& args) {
     net = net_cli::read(args);
     o.data = args.required("data");
     o.plant = args.get("plant").value_or(net.daemon ? net.daemon->plant_path : "");
@@ -135,14 +120,6 @@ int run(int argc, char** argv) {
     o.session = args.get("session") ? static_cast<std::int64_t>(args.number("session", 0)) : random_session();
     o.first_seq = static_cast<std::int64_t>(args.number("first-seq", 1));
     o.wait_readers = args.number("wait-readers", 10);
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm replay: %s\n%s%s", e.what(), kUsage, net_cli::kOptionsHelp);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm replay: %s\n", e.what());
-    return 1;
-  }
-  try {
     const PlantModel plant = config::load_plant(o.plant);
     const config::Recording rec = config::load_recording(o.data);
     if (o.controller.empty()) o.controller = plant.name;
@@ -151,13 +128,9 @@ int run(int argc, char** argv) {
     auto t = transport::create(net.transport, error);
     if (!t) throw std::runtime_error(error);
     t->advertise(transport::Transport::Topic::kSample);
-    signal(SIGINT, on_stop);
-    signal(SIGTERM, on_stop);
+    net_cli::stop_on_signals();
     return replay(*t, plant, rec, o);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm replay: %s\n", e.what());
-    return 1;
-  }
+  });
 }
 
 const bool registered =

@@ -111,13 +111,9 @@ int run_simulate(int argc, char** argv) {
   std::uint64_t seed = 0;
   std::optional<std::string> plant_path;
   double move_weight_scale = 1.0;
-  try {
-    const Args args(argc, argv, {"plant", "scenario", "samples", "seed", "out", "edit", "move-weight-scale"},
-                    {"list", "help"});
-    if (args.flag("help")) {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
+  return run_command("mpm simulate", kUsage, argc, argv,
+                     {"plant", "scenario", "samples", "seed", "out", "edit", "move-weight-scale"}, {"list"},
+                     [&](const Args& args) {
     if (args.flag("list")) {
       list_scenarios();
       return 0;
@@ -131,15 +127,11 @@ int run_simulate(int argc, char** argv) {
     move_weight_scale = args.number("move-weight-scale", 1.0);
     if (!(move_weight_scale > 0.0 && move_weight_scale <= 1e6))
       throw UsageError("--move-weight-scale: expected a number in (0, 1e6]");
-    const sim::Scenario* scenario = sim::find_scenario(scenario_name);
-    if (!scenario) throw UsageError("unknown scenario '" + scenario_name + "' (mpm simulate --list shows them)");
-    if (scenario->plant_file.empty() && !plant_path)
+    const sim::Scenario* found = sim::find_scenario(scenario_name);
+    if (!found) throw UsageError("unknown scenario '" + scenario_name + "' (mpm simulate --list shows them)");
+    if (found->plant_file.empty() && !plant_path)
       throw UsageError("scenario " + scenario_name + " needs --plant FILE: it is tuned from the plant file given");
-  } catch (const UsageError& e) {
-    return usage_error(e.what());
-  }
-  try {
-    const sim::Scenario& scenario = *sim::find_scenario(scenario_name);
+    const sim::Scenario& scenario = *found;
     sim::ResolvedPlant plant = plant_path ? sim::ResolvedPlant{config::load_plant(*plant_path), *plant_path}
                                           : sim::default_plant(scenario);
     config::refuse_input_as_output(out_path, {plant.source});
@@ -167,10 +159,7 @@ int run_simulate(int argc, char** argv) {
                 static_cast<unsigned long long>(seed), loop.controller().constrained_samples());
     config::write_stdout("");  // flushes; a failed write of the line above is an error
     return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm simulate: %s\n", e.what());
-    return 1;
-  }
+  });
 }
 
 const bool registered = register_command(

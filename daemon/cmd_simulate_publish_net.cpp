@@ -1,9 +1,7 @@
 // `mpm simulate-live`: runs a closed-loop scenario live and publishes every
 // sample on LCM or DDS, as the MPC of a real plant would: a demo source for
 // mpmd that needs no recording.
-#include <signal.h>
 
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <random>
@@ -28,14 +26,7 @@ constexpr const char* kUsage =
     "options:\n"
     "  --plant FILE           nominal model (default: the scenario's)\n"
     "  --samples N            samples to publish (default 0: until interrupted)\n"
-    "  --seed S               random seed (default 1)\n"
-    "  --rate HZ              samples per second (default: 1 / the plant's sample_time)\n"
-    "  --as-fast-as-possible  no pacing\n"
-    "  --controller ID        controller id (default: the config's, else the plant's name)\n"
-    "  --wait-readers SECONDS DDS: wait this long for a subscriber first (default 10)\n";
-
-std::atomic<bool> g_stop{false};
-void on_stop(int) { g_stop = true; }
+    "  --seed S               random seed (default 1)\n";
 
 std::int64_t unix_micros() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -68,7 +59,7 @@ int publish_loop(transport::Transport& t, sim::ClosedLoop& loop, const Options& 
   }
   const auto start = std::chrono::steady_clock::now();
   long sent = 0;
-  for (long k = 0; !g_stop && (o.samples == 0 || k < o.samples); ++k) {
+  for (long k = 0; !net_cli::g_stop && (o.samples == 0 || k < o.samples); ++k) {
     if (rate > 0) std::this_thread::sleep_until(start + std::chrono::duration<double>(static_cast<double>(k) / rate));
     const sim::LoopSample& x = loop.step();
     loop.fill_row(x, row.data());
@@ -88,21 +79,15 @@ int publish_loop(transport::Transport& t, sim::ClosedLoop& loop, const Options& 
 int run(int argc, char** argv) {
   net_cli::NetOptions net;
   Options o;
-  try {
-    const Args args(argc, argv,
-                    net_cli::valued_options({"scenario", "publish", "plant", "samples", "seed", "rate", "controller",
-                                             "wait-readers"}),
-                    {"as-fast-as-possible", "help"});
-    if (args.flag("help")) {
-      std::printf("%s%s", kUsage, net_cli::kOptionsHelp);
-      return 0;
-    }
+  const std::string usage = std::string(kUsage) + net_cli::kPublisherHelp + net_cli::kOptionsHelp;
+  return run_command("mpm simulate-live", usage.c_str(), argc, argv, net_cli::valued_options({"scenario", "publish", "plant", "samples", "seed", "rate", "controller",
+                                             "wait-readers"}), {"as-fast-as-possible"}, [&](const Args& args) {
     net = net_cli::read(args);
     o.scenario = args.required("scenario");
-    const sim::Scenario* scenario = sim::find_scenario(o.scenario);
-    if (!scenario) throw UsageError("unknown scenario '" + o.scenario + "' (mpm simulate --list)");
+    const sim::Scenario* found = sim::find_scenario(o.scenario);
+    if (!found) throw UsageError("unknown scenario '" + o.scenario + "' (mpm simulate --list)");
     o.plant = args.get("plant");
-    if (scenario->plant_file.empty() && !o.plant)
+    if (found->plant_file.empty() && !o.plant)
       throw UsageError("scenario " + o.scenario + " needs --plant FILE: it is tuned from the plant file given");
     o.controller = args.get("controller").value_or(net.daemon ? net.daemon->controller_id : "");
     o.samples = args.integer("samples", 0);
@@ -110,15 +95,7 @@ int run(int argc, char** argv) {
     o.rate = net_cli::read_rate(args);
     if (o.samples < 0) throw UsageError("--samples must not be negative");
     o.wait_readers = args.number("wait-readers", 10);
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "mpm simulate-live: %s\n%s%s", e.what(), kUsage, net_cli::kOptionsHelp);
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm simulate-live: %s\n", e.what());
-    return 1;
-  }
-  try {
-    const sim::Scenario& scenario = *sim::find_scenario(o.scenario);
+    const sim::Scenario& scenario = *found;
     const sim::ResolvedPlant plant =
         o.plant ? sim::ResolvedPlant{config::load_plant(*o.plant), *o.plant} : sim::default_plant(scenario);
     if (o.controller.empty()) o.controller = plant.model.name;
@@ -127,13 +104,9 @@ int run(int argc, char** argv) {
     auto t = transport::create(net.transport, error);
     if (!t) throw std::runtime_error(error);
     t->advertise(transport::Transport::Topic::kSample);
-    signal(SIGINT, on_stop);
-    signal(SIGTERM, on_stop);
+    net_cli::stop_on_signals();
     return publish_loop(*t, loop, o);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "mpm simulate-live: %s\n", e.what());
-    return 1;
-  }
+  });
 }
 
 const bool registered = register_command(

@@ -4,13 +4,15 @@
 // override the file.
 #pragma once
 
+#include <atomic>
+#include <csignal>
 #include <optional>
 #include <set>
 #include <string>
 
 #include "config/daemon_config.hpp"
 #include "daemon/args.hpp"
-#include "transport/transport_settings.hpp"
+#include "settings/transport_settings.hpp"
 
 namespace mpm::net_cli {
 
@@ -22,6 +24,21 @@ constexpr const char* kOptionsHelp =
     "  --dds-domain N       DDS domain id (default 0)\n"
     "  --dds-config FILE    Cyclone DDS XML configuration (default: $CYCLONEDDS_URI)\n"
     "  --sample-channel C, --alarm-channel C, --status-channel C   LCM channels / DDS topics\n";
+
+// The options of a publisher (mpm replay, mpm simulate-live), for its usage.
+constexpr const char* kPublisherHelp =
+    "  --rate HZ              samples per second (default: 1 / the plant's sample_time)\n"
+    "  --as-fast-as-possible  no pacing\n"
+    "  --controller ID        controller id (default: the config's, else the plant's name)\n"
+    "  --wait-readers SECONDS DDS: wait this long for a subscriber before publishing (default 10)\n";
+
+// Set by SIGINT and SIGTERM once stop_on_signals() ran: the publishing and
+// listening loops end at their next step.
+inline std::atomic<bool> g_stop{false};
+inline void stop_on_signals() {
+  std::signal(SIGINT, [](int) { g_stop = true; });
+  std::signal(SIGTERM, [](int) { g_stop = true; });
+}
 
 inline std::set<std::string> valued_options(std::set<std::string> more) {
   more.insert({"config", "transport", "lcm-url", "dds-domain", "dds-config", "sample-channel", "alarm-channel",

@@ -249,9 +249,9 @@ void paper_section(const ReportInputs& in, std::vector<Plot>& plots, std::ostrin
       Plot v{tag("v", j) + tag("_", i), p.outputs[j] + ": residual variance against AR order, " + p.inputs[i],
              "AR order na", {}, {}, "colors:['#444','#1f77b4','#d62728'],drawPoints:true,digitsAfterDecimal:4"};
       for (int nb = 0; nb <= kPaperInputLags; ++nb) v.labels.push_back("R(" + p.inputs[i] + "," + std::to_string(nb) + ")");
-      for (int na = 1; na <= kPaperArOrder; ++na) {
+      for (std::size_t na = 1; na <= std::size_t{kPaperArOrder}; ++na) {
         std::vector<double> row{double(na)};
-        for (int nb = 0; nb <= kPaperInputLags; ++nb) row.push_back(w.variance[i][nb][na - 1]);
+        for (std::size_t nb = 0; nb <= std::size_t{kPaperInputLags}; ++nb) row.push_back(w.variance[i][nb][na - 1]);
         v.rows.push_back(std::move(row));
       }
       body << "<div class='plot small' id=" << v.id << "></div>\n";
@@ -418,7 +418,7 @@ std::string report_html(const ReportInputs& in) {
            {"before", "after", "+bound", "-bound"}, {},
            "colors:['#d62728','#2ca02c','#888','#888'],drawPoints:true,series:{'+bound':{strokePattern:[4,4],"
            "drawPoints:false},'-bound':{strokePattern:[4,4],drawPoints:false}}"};
-    for (int l = 0; l <= kMaxLag; ++l) a.rows.push_back({double(l), rb[l], ra[l], bound, -bound});
+    for (std::size_t l = 0; l <= std::size_t{kMaxLag}; ++l) a.rows.push_back({double(l), rb[l], ra[l], bound, -bound});
     body << "<div class=plot id=" << a.id << "></div>\n";
     plots.push_back(std::move(a));
   }
@@ -435,8 +435,8 @@ std::string report_html(const ReportInputs& in) {
              {"before", "after", "+bound", "-bound"}, {},
              "colors:['#d62728','#2ca02c','#888','#888'],series:{'+bound':{strokePattern:[4,4]},"
              "'-bound':{strokePattern:[4,4]}}"};
-      for (int l = -kMaxLag; l <= kMaxLag; ++l)
-        x.rows.push_back({double(l), xb[l + kMaxLag], xa[l + kMaxLag], bound, -bound});
+      for (std::size_t l = 0; l <= 2 * std::size_t{kMaxLag}; ++l)  // lags -kMaxLag..kMaxLag
+        x.rows.push_back({double(l) - kMaxLag, xb[l], xa[l], bound, -bound});
       body << "<div class='plot small' id=" << x.id << "></div>\n";
       plots.push_back(std::move(x));
     }
@@ -449,7 +449,7 @@ std::string report_html(const ReportInputs& in) {
     const auto sn = step(nominal, h), sf = step(*f.fitted, h);
     Plot s{tag("s", k), tag("finding ", k + 1) + " (" + f.physics + "): " + arrow(in, f),
            "t [s]", {"nominal", "fitted"}, {}, "colors:['#d62728','#2ca02c'],stepPlot:true"};
-    for (int t = 0; t < h; ++t) s.rows.push_back({t * ts, sn[t], sf[t]});
+    for (std::size_t t = 0; t < static_cast<std::size_t>(h); ++t) s.rows.push_back({double(t) * ts, sn[t], sf[t]});
     body << "<div class='plot small' id=" << s.id << "></div>\n";
     plots.push_back(std::move(s));
   }

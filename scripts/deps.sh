@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(
   cmake g++ pkg-config
-  libeigen3-dev libboost-dev libyaml-cpp-dev
+  libeigen3-dev libboost-dev libyaml-cpp-dev libcli11-dev
   liblcm-dev liblcm-bin liblcm-java libglib2.0-dev
   cyclonedds-dev cyclonedds-tools
   libsystemd-dev systemd

@@ -23,7 +23,7 @@
 #include <cstdint>
 
 #include "transport/messages.hpp"
-#include "transport/transport_settings.hpp"
+#include "settings/transport_settings.hpp"
 
 namespace mpm::transport {
 

@@ -15,7 +15,7 @@
 #include <string>
 
 #include "transport/messages.hpp"
-#include "transport/transport_settings.hpp"
+#include "settings/transport_settings.hpp"
 
 namespace mpm::transport {
 
@@ -90,7 +90,7 @@ class Transport {
   // "lcm udpm://..." or "dds domain 0", for logs.
   virtual std::string describe() const = 0;
 
-  // What a received sample may contain (transport_settings.hpp): a sample
+  // What a received sample may contain (settings/transport_settings.hpp): a sample
   // beyond these is counted in receive_errors() and never handed on. May be
   // called from any thread (a reload with a new plant); a sample being
   // decoded meanwhile is judged by the old or the new limits.

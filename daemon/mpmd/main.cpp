@@ -15,6 +15,8 @@
 #include <cstring>
 #include <string>
 
+#include "config/settings_doc.hpp"
+#include "daemon/args.hpp"
 #include "daemon/mpmd/log.hpp"
 #include "daemon/mpmd/notifier.hpp"
 #include "daemon/mpmd/receiver.hpp"
@@ -51,6 +53,7 @@ constexpr const char* kUsage =
     "  Watches one controller for model-plant mismatch (see README: mpmd).\n"
     "  --config FILE   service configuration (YAML)\n"
     "  --check         load and validate the configuration, then exit\n"
+    "  --settings-table  print every setting (key, default, allowed values, meaning) as Markdown\n"
     "  --version       print the version and exit\n";
 
 struct Options {
@@ -58,32 +61,21 @@ struct Options {
   bool check_only = false;
 };
 
-// 0 = run, else the exit code.
+constexpr int kRun = -1;
+
+// kRun, or the exit code (--help, --version, --settings-table: 0; a usage
+// error: 2, as every mpm command).
 int parse_options(int argc, char** argv, Options& options) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      return -1;
-    } else if (arg == "--version") {
-      std::printf("mpmd %s\n", MPM_VERSION);
-      return -1;
-    } else if (arg == "--config" && i + 1 < argc) {
-      options.config_path = argv[++i];
-    } else if (arg.rfind("--config=", 0) == 0) {
-      options.config_path = arg.substr(9);
-    } else if (arg == "--check") {
-      options.check_only = true;
-    } else {
-      std::fprintf(stderr, "mpmd: unexpected argument '%s'\n%s", arg.c_str(), kUsage);
-      return 2;
-    }
-  }
-  if (options.config_path.empty()) {
-    std::fprintf(stderr, "mpmd: --config is required\n%s", kUsage);
-    return 2;
-  }
-  return 0;
+  return mpm::run_command("mpmd", kUsage, argc, argv, {"config"}, {"check", "settings-table"},
+                          [&](const mpm::Args& args) {
+                            if (args.flag("settings-table")) {
+                              std::fputs(mpm::config::settings_table_markdown().c_str(), stdout);
+                              return mpm::kExitOk;
+                            }
+                            options.config_path = args.required("config");
+                            options.check_only = args.flag("check");
+                            return kRun;
+                          });
 }
 
 }  // namespace
@@ -91,7 +83,7 @@ int parse_options(int argc, char** argv, Options& options) {
 int main(int argc, char** argv) {
   using namespace mpm;
   Options options;
-  if (const int rc = parse_options(argc, argv, options); rc != 0) return rc < 0 ? 0 : rc;
+  if (const int rc = parse_options(argc, argv, options); rc != kRun) return rc;
   install_signal_handlers();
 
   // 1. Configuration: one clear error and a non-zero exit when invalid.

@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "config/service_settings.hpp"
 #include "core/granger_monitor.hpp"
 #include "core/mimo_model.hpp"
 #include "core/monitor_front_end.hpp"
@@ -41,33 +42,8 @@
 
 namespace mpm {
 
-struct ServiceSettings {
-  std::string controller_id;
-  MonitorSettings monitor;
-  // Regress on plain input lags (the paper's) instead of lags of the input
-  // filtered through the nominal channel (what `mpm monitor` does by default).
-  bool plain_lags = false;
-  // Samples skipped after the nominal model starts (or restarts after a long
-  // gap) while its start-up transient decays; -1 = the plant's settling time
-  // (settle_length with kLiveSettleCap). `mpm monitor --settle-samples`.
-  int settle_samples = -1;
-  double log_interval = 60.0;  // seconds between repeats of one kind of log line
-  // Largest sequence gap (or step back) taken as plausible; beyond it the
-  // tracking resynchronises on the new number (sequence_tracker.hpp).
-  std::int64_t max_sequence_jump = SequenceTracker::kDefaultMaxJump;
-  // Seconds without a usable sample after which the status says not ready;
-  // -1 = automatic (the longer of 60 s and 10 sample times), 0 = never.
-  double stale_after = -1.0;
-  // Samples kept for the diagnosis of a raised output (diagnosis_worker.hpp);
-  // 0 = no diagnosis.
-  int diagnosis_window = 0;
-  // Usable samples between looks of the diagnosis scan over the last
-  // diagnosis_window samples (needs diagnosis_window > 0); 0 = no scan. The
-  // scan takes its share of monitor.detector.false_alarms_per_year
-  // (share_rate). `mpm monitor --scan-interval`. Off here (unit tests of
-  // the sequential path); mpmd's configuration turns it on (500).
-  int scan_interval = 0;
-};
+// Its settings: one struct with mpmd.yaml's (config/service_settings.hpp).
+using ServiceSettings = config::ServiceSettings;
 
 struct ServiceCounters {
   std::uint64_t seen = 0;          // samples of this controller

@@ -142,16 +142,12 @@ void ServiceLoop::apply_reload() {
   }
   const auto& was = running_.config.transport;
   const auto& now = next->config.transport;
-  if (was.kind != now.kind || was.lcm.url != now.lcm.url || was.lcm.sample_channel != now.lcm.sample_channel ||
-      was.lcm.alarm_channel != now.lcm.alarm_channel || was.lcm.status_channel != now.lcm.status_channel ||
-      was.dds.domain != now.dds.domain || was.dds.config != now.dds.config ||
-      was.dds.sample_topic != now.dds.sample_topic || was.dds.alarm_topic != now.dds.alarm_topic ||
-      was.dds.status_topic != now.dds.status_topic || running_.config.queue_capacity != next->config.queue_capacity) {
+  if (was != now || running_.config.queue_capacity != next->config.queue_capacity) {
     if (report) {
       log::write(log::Level::kWarning, "transport and queue settings take effect at the next restart%s", suppressed);
     }
   }
-  if (next->monitor_fingerprint != running_.monitor_fingerprint) {
+  if (!next->same_monitor(running_)) {
     auto service = make_service(*next, service_->alarm_sink(), error);
     if (!service) {
       if (report || error != last_reload_error_) {

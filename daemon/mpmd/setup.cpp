@@ -19,21 +19,6 @@ std::string read_text(const std::string& path) {
   return text.str();
 }
 
-std::string fingerprint(const config::DaemonConfig& c) {
-  const MonitorSettings& m = c.monitor;
-  std::ostringstream f;
-  f.precision(17);
-  f << c.controller_id << '\n'
-    << m.ar_order << ' ' << m.input_order << ' ' << m.forgetting << ' ' << m.false_alarm << ' '
-    << m.detector.false_alarms_per_year << ' ' << m.detector.sample_time << ' ' << m.detector.crossing_constant << ' '
-    << m.outlier_limit << ' ' << m.warmup << ' ' << m.gamma_lambda << ' '
-    << m.input_pole << ' ' << c.input_pole_auto << ' ' << c.plain_lags << ' ' << c.settle_samples << ' '
-    << c.log_interval << ' ' << c.max_sequence_jump << ' ' << c.stale_after << '\n'
-    << c.plant_path << '\n'
-    << read_text(c.plant_path);
-  return f.str();
-}
-
 }  // namespace
 
 std::optional<LoadedConfig> load_config(const std::string& path, std::string& error) {
@@ -41,7 +26,7 @@ std::optional<LoadedConfig> load_config(const std::string& path, std::string& er
     LoadedConfig loaded;
     loaded.config = config::load_daemon_config(path);
     loaded.plant = config::load_plant(loaded.config.plant_path, loaded.config.limits);
-    loaded.monitor_fingerprint = fingerprint(loaded.config);
+    loaded.plant_text = read_text(loaded.config.plant_path);
     return loaded;
   } catch (const config::ConfigError& e) {
     error = e.what();
@@ -53,17 +38,8 @@ std::optional<LoadedConfig> load_config(const std::string& path, std::string& er
 
 std::unique_ptr<MonitorService> make_service(const LoadedConfig& loaded, MonitorService::AlarmSink on_alarm,
                                              std::string& error) {
-  ServiceSettings settings;
-  settings.controller_id = loaded.config.controller_id;
-  settings.monitor = loaded.config.monitor;
-  if (loaded.config.input_pole_auto) settings.monitor.input_pole = dominant_pole(loaded.plant);
-  settings.plain_lags = loaded.config.plain_lags;
-  settings.settle_samples = loaded.config.settle_samples;
-  settings.log_interval = loaded.config.log_interval;
-  settings.max_sequence_jump = loaded.config.max_sequence_jump;
-  settings.stale_after = loaded.config.stale_after;
-  settings.diagnosis_window = loaded.config.diagnosis_window;
-  settings.scan_interval = loaded.config.scan_interval;
+  ServiceSettings settings = loaded.config;  // the service's part of the file
+  if (settings.input_pole_auto) settings.monitor.input_pole = dominant_pole(loaded.plant);
   try {
     return std::make_unique<MonitorService>(loaded.plant, settings, std::move(on_alarm));
   } catch (const std::exception& e) {
@@ -73,7 +49,12 @@ std::unique_ptr<MonitorService> make_service(const LoadedConfig& loaded, Monitor
 }
 
 std::uint64_t checkpoint_fingerprint(const LoadedConfig& loaded) {
-  return checkpoint::fnv1a(loaded.monitor_fingerprint.data(), loaded.monitor_fingerprint.size());
+  const config::ServiceSettings& s = loaded.config;
+  std::string f = s.controller_id + '\n' + (s.input_pole_auto ? "input_pole=auto\n" : "");
+  config::append_values(config::ServiceSettings::monitor_fields(), s, f);
+  config::append_values(config::ServiceSettings::fields(), s, f);
+  f += '\n' + loaded.config.plant_path + '\n' + loaded.plant_text;
+  return checkpoint::fnv1a(f.data(), f.size());
 }
 
 bool resume_from_checkpoint(std::unique_ptr<MonitorService>& service, const LoadedConfig& loaded,

@@ -17,9 +17,16 @@ namespace mpm {
 struct LoadedConfig {
   config::DaemonConfig config;
   PlantModel plant;
-  // What the monitor depends on (controller, plant file text, settings): a
-  // reload that leaves it unchanged keeps the running statistics.
-  std::string monitor_fingerprint;
+  // The plant file's text: with the service settings (config's
+  // ServiceSettings part), what the monitor depends on. A reload that
+  // leaves both unchanged keeps the running statistics.
+  std::string plant_text;
+
+  // Same service settings and plant: the running monitor stays.
+  bool same_monitor(const LoadedConfig& other) const {
+    return static_cast<const config::ServiceSettings&>(config) == other.config && config.plant_path == other.config.plant_path &&
+           plant_text == other.plant_text;
+  }
 };
 
 // Reads mpmd.yaml and its plant file. On failure returns nothing and sets
@@ -38,7 +45,8 @@ std::unique_ptr<MonitorService> make_service(const LoadedConfig& loaded, Monitor
 // service could not be rebuilt.
 bool resume_from_checkpoint(std::unique_ptr<MonitorService>& service, const LoadedConfig& loaded,
                             std::string& error);
-// The checkpoint's fingerprint of a configuration (its monitor_fingerprint).
+// The checkpoint's fingerprint of a configuration: a hash of every service
+// setting (from the settings tables), the controller, the plant's path and text.
 std::uint64_t checkpoint_fingerprint(const LoadedConfig& loaded);
 
 // An alarm sink that publishes through `*transport` (once it is set) and

@@ -46,7 +46,7 @@ TEST(OrderSweep, VariancesAndArPartAreThePapersOnAPlantedArx) {
   EXPECT_NEAR(w.variance[0][1][0], 1.0, 0.04);
   EXPECT_NEAR(w.variance[0][2][19], 1.0, 0.04);
   // u2 has no effect: its curves lie on the AR-only curve.
-  for (int na = 1; na <= 20; ++na) EXPECT_NEAR(w.variance[1][2][na - 1] / w.variance[1][0][na - 1], 1.0, 2e-3);
+  for (std::size_t na = 1; na <= 20; ++na) EXPECT_NEAR(w.variance[1][2][na - 1] / w.variance[1][0][na - 1], 1.0, 2e-3);
   // Nested least squares: more regressors never leave more variance.
   for (std::size_t i = 0; i < 2; ++i)
     for (std::size_t nb = 0; nb <= 2; ++nb)
@@ -58,7 +58,7 @@ TEST(OrderSweep, VariancesAndArPartAreThePapersOnAPlantedArx) {
       }
   // Beside u1's lags the AR part is that of 1 - N^-1 = 0.9 q^-1.
   EXPECT_NEAR(w.ar[0][0], 0.9, 0.02);
-  for (int l = 1; l < 20; ++l) EXPECT_NEAR(w.ar[0][l], 0.0, 0.03) << l;
+  for (std::size_t l = 1; l < 20; ++l) EXPECT_NEAR(w.ar[0][l], 0.0, 0.03) << l;
   EXPECT_EQ(w.used, 20000u - 20u);
 }
 

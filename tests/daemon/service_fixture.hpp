@@ -31,6 +31,7 @@ inline ServiceSettings fast_service(const std::string& controller = "wb") {
   s.monitor = fast_settings();
   s.settle_samples = 100;
   s.log_interval = 3600;  // "logged once" within a test
+  s.diagnosis_window = 0;  // no diagnosis thread unless a test asks for one
   return s;
 }
 

@@ -239,8 +239,8 @@ TEST(Checkpoint, ConfigurationKeys) {
     return std::string();
   };
   EXPECT_NE(error_of("checkpoint_interval: 0\n").find("mpmd.yaml:3"), std::string::npos);
-  EXPECT_NE(error_of("checkpoint_interval: 0\n").find("0.05..86400"), std::string::npos);
-  EXPECT_NE(error_of("diagnosis_window: 50\n").find("200..1000000"), std::string::npos);
+  EXPECT_NE(error_of("checkpoint_interval: 0\n").find("checkpoint_interval must be in [0.05, 86400]"), std::string::npos);
+  EXPECT_NE(error_of("diagnosis_window: 50\n").find("diagnosis_window must be 0 or a whole number in [200, 1000000]"), std::string::npos);
 }
 
 }  // namespace

@@ -4,8 +4,15 @@
 // ready-made configurations are valid.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <stdexcept>
+#include <variant>
+
 #include "child_process.hpp"
 #include "config/daemon_config.hpp"
+#include "config/file_text.hpp"
+#include "config/setting_text.hpp"
+#include "config/settings_doc.hpp"
 #include "config/plant_loader.hpp"
 
 namespace mpm {
@@ -121,6 +128,135 @@ TEST(DaemonConfig, ErrorsNameFileLineKeyAndExpectation) {
   e = error_of("controller_id: [unclosed\n");
   EXPECT_NE(e.find("mpmd.yaml:"), std::string::npos) << e;
   EXPECT_NE(e.find("invalid YAML"), std::string::npos) << e;
+}
+
+// Validation returns {field, message}: a caller points at the key by its
+// name, not by reading the text; every range is in one row.
+TEST(DaemonConfig, ErrorsNameTheirField) {
+  config::ServiceSettings s;
+  EXPECT_TRUE(s.errors().empty());
+  s.monitor.forgetting = 1.5;
+  s.monitor.detector.crossing_constant = -1;
+  s.stale_after = -3;
+  s.diagnosis_window = 100;
+  std::vector<std::string> fields;
+  for (const FieldError& e : s.errors()) fields.push_back(e.field);
+  EXPECT_EQ(fields, (std::vector<std::string>{"forgetting", "crossing_constant", "stale_after", "diagnosis_window"}));
+  s.diagnosis_window = 0;  // its "off" value, outside its range
+  s.stale_after = -1;      // "auto"
+  EXPECT_EQ(s.errors().size(), 2u);
+}
+
+// A file's scalar and a flag's text are read by one function (setting_text.hpp):
+// words, bools, whole numbers that must fit their type, ranges.
+TEST(DaemonConfig, SettingTextIsCheckedBeforeItIsStored) {
+  const auto row = [](const char* key) {
+    for (const auto& r : config::ServiceSettings::monitor_fields())
+      if (std::string(r.key) == key) return r;
+    throw std::runtime_error(key);
+  };
+  config::ServiceSettings s;
+  EXPECT_EQ(config::set_from_text(row("settle_samples"), s, "50"), "");
+  EXPECT_EQ(s.settle_samples, 50);
+  EXPECT_EQ(config::set_from_text(row("settle_samples"), s, "auto"), "");
+  EXPECT_EQ(s.settle_samples, -1);
+  EXPECT_EQ(config::set_from_text(row("input_pole"), s, "auto"), "");
+  EXPECT_TRUE(s.input_pole_auto);
+  EXPECT_EQ(config::set_from_text(row("regressors"), s, "plain_lags"), "");
+  EXPECT_TRUE(s.plain_lags);
+  EXPECT_NE(config::set_from_text(row("regressors"), s, "lags"), "");
+  EXPECT_NE(config::set_from_text(row("warmup"), s, "1e30").find("expected an integer"), std::string::npos);
+  EXPECT_NE(config::set_from_text(row("ar_order"), s, "4.5"), "");
+  EXPECT_NE(config::set_from_text(row("forgetting"), s, "0.5").find("forgetting must be in (0.9, 1]"),
+            std::string::npos);
+  EXPECT_NE(config::set_from_text(row("forgetting"), s, "nan"), "");
+  EXPECT_EQ(config::set_from_text(row("detector_thresholds"), s, "50,51.5"), "");
+  EXPECT_EQ(s.monitor.detector.thresholds, (std::vector<double>{50, 51.5}));
+  const config::ServiceSettings unchanged = s;
+  EXPECT_NE(config::set_from_text(row("ar_order"), s, "300"), "");
+  EXPECT_TRUE(s == unchanged) << "a refused value is not stored";
+}
+
+// One value of a number row other than its default, inside its range.
+template <class S>
+bool change(const FieldRow<S>& row, S& s) {
+  const double now = number_of(row.get(s));
+  if (std::isnan(now)) return false;
+  const Range& r = row.range;
+  double other = std::isfinite(r.max) ? r.max : now + 1;
+  if (r.max_open || other == now) other = std::isfinite(r.min) ? r.min + (r.whole ? 1 : 0.001) : now - 1;
+  if (other == now) other = now + (r.whole ? 1 : 0.001);
+  EXPECT_TRUE(r.contains(other)) << row.key << " " << other;
+  std::visit(
+      [&](auto* p) {
+        using T = std::remove_pointer_t<decltype(p)>;
+        if constexpr (std::is_arithmetic_v<T>) *p = static_cast<T>(other);
+      },
+      row.ref(s));
+  return true;
+}
+
+// A reload keeps the monitor only when every setting is the same
+// (operator== = default) and the checkpoint's fingerprint (append_values)
+// sees every row: a change of any one number setting shows in both.
+TEST(DaemonConfig, EverySettingCountsForReloadAndFingerprint) {
+  const config::ServiceSettings defaults;
+  std::string base;
+  config::append_values(config::ServiceSettings::monitor_fields(), defaults, base);
+  config::append_values(config::ServiceSettings::fields(), defaults, base);
+  int changed = 0;
+  for (const auto* rows : {&config::ServiceSettings::monitor_fields(), &config::ServiceSettings::fields()}) {
+    for (const auto& row : *rows) {
+      config::ServiceSettings s = defaults;
+      if (!change(row, s)) continue;
+      ++changed;
+      EXPECT_FALSE(s == defaults) << row.key;
+      std::string f;
+      config::append_values(config::ServiceSettings::monitor_fields(), s, f);
+      config::append_values(config::ServiceSettings::fields(), s, f);
+      EXPECT_NE(f, base) << row.key;
+    }
+  }
+  EXPECT_GE(changed, 15);
+}
+
+// deploy/mpmd.yaml, the example config, lists every key of the tables with
+// its default: read, it equals the defaults (its own controller, plant,
+// transport and checkpoint path aside).
+TEST(DaemonConfig, ExampleConfigListsEverySettingWithItsDefault) {
+  const std::string text = config::detail::read_file(MPM_SOURCE_DIR "/deploy/mpmd.yaml", 1 << 20);
+  const auto listed = [&](const std::string& indent, const char* key) {
+    return text.find("\n" + indent + key + ":") != std::string::npos;
+  };
+  for (const auto& row : config::ServiceSettings::monitor_fields()) EXPECT_TRUE(listed("  ", row.key)) << row.key;
+  for (const auto& row : config::ServiceSettings::fields()) EXPECT_TRUE(listed("", row.key)) << row.key;
+  for (const auto& row : config::DaemonConfig::fields()) EXPECT_TRUE(listed("", row.key)) << row.key;
+  for (const auto& row : config::Limits::fields()) EXPECT_TRUE(listed("  ", row.key)) << row.key;
+
+  test::TempDir dir;  // as installed: the plant and the DDS configuration beside it
+  dir.write("wood-berry.yaml", config::detail::read_file(kPlant, 1 << 20));
+  dir.write("cyclonedds-loopback.xml", "<CycloneDDS/>");
+  const auto c = parse_daemon_config(text, "mpmd.yaml", dir.path());
+  config::ServiceSettings expected;
+  expected.controller_id = c.controller_id;
+  EXPECT_TRUE(static_cast<const config::ServiceSettings&>(c) == expected);
+  const config::DaemonConfig defaults;
+  EXPECT_EQ(c.status_period, defaults.status_period);
+  EXPECT_EQ(c.queue_capacity, defaults.queue_capacity);
+  EXPECT_EQ(c.checkpoint_interval, defaults.checkpoint_interval);
+  EXPECT_TRUE(c.limits == defaults.limits);
+}
+
+// deploy/README.md's table of settings is the tables' own, as
+// `mpmd --settings-table` prints it (regenerate it with that).
+TEST(DaemonConfig, DocsTableIsGeneratedFromTheRows) {
+  const std::string text = config::detail::read_file(MPM_SOURCE_DIR "/deploy/README.md", 1 << 20);
+  const std::string begin = "<!-- settings table: mpmd --settings-table -->\n";
+  const auto from = text.find(begin);
+  const auto to = text.find("<!-- end of settings table -->");
+  ASSERT_NE(from, std::string::npos);
+  ASSERT_NE(to, std::string::npos);
+  EXPECT_EQ(text.substr(from + begin.size(), to - from - begin.size()), config::settings_table_markdown());
 }
 
 // The loaders' caps (config/limits.hpp) from a `limits:` section: a plant

@@ -20,6 +20,7 @@ namespace {
 ServiceSettings with_diagnosis() {
   ServiceSettings s = test::fast_service();
   s.diagnosis_window = 3000;
+  s.scan_interval = 0;  // the diagnosis of a raise only (the scan: test_diagnosis_scan.cpp)
   return s;
 }
 

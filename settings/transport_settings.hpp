@@ -16,6 +16,7 @@ struct LcmSettings {
   std::string alarm_channel = "MPM_ALARM";
   std::string status_channel = "MPM_STATUS";
   std::string diagnosis_channel = "MPM_DIAGNOSIS";
+  bool operator==(const LcmSettings&) const = default;
 };
 
 struct DdsSettings {
@@ -28,6 +29,7 @@ struct DdsSettings {
   std::string status_topic = "mpm_status";
   std::string diagnosis_topic = "mpm_diagnosis";
   int sample_history = 64;  // KEEP_LAST depth of sample writer and reader
+  bool operator==(const DdsSettings&) const = default;
 };
 
 // What a received sample may contain. Every length on the wire is checked
@@ -40,6 +42,7 @@ struct SampleLimits {
   std::uint32_t max_channels = 1024; // bound of u and y when the plant is not known (mpm listen)
   std::uint32_t max_extra = 256;     // named extra signals
   std::uint32_t max_string = 256;    // bytes of controller_id and of each extra name
+  bool operator==(const SampleLimits&) const = default;
 };
 
 struct Settings {
@@ -47,6 +50,7 @@ struct Settings {
   SampleLimits sample_limits;  // set by mpmd from its plant
   LcmSettings lcm;
   DdsSettings dds;
+  bool operator==(const Settings&) const = default;  // a reload compares them
 };
 
 inline const char* to_string(Kind kind) noexcept { return kind == Kind::kDds ? "dds" : "lcm"; }
