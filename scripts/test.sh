@@ -14,8 +14,8 @@ echo "== Release build and tests"
 native=OFF
 grep -qw avx2 /proc/cpuinfo && grep -qw fma /proc/cpuinfo && native=ON
 # Warnings (MPM_STRICT_WARNINGS, on by default) are errors in the suite's
-# builds once the tree is clean of them: werror=ON here.
-werror=OFF
+# builds (the tree is clean of them: GCC 12, Release and ASan).
+werror=ON
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMPM_NATIVE_ARCH=$native -DMPM_WERROR=$werror >/dev/null
 cmake --build build -j"$jobs"
 ctest --test-dir build --output-on-failure -j"$jobs" --timeout 600 || status=1
