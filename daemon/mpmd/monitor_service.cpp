@@ -78,7 +78,8 @@ MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& s
       nan_u_(plant.n_inputs(), kNaN),
       nan_y_(plant.n_outputs(), kNaN),
       edges_(plant.n_outputs(), plant.n_inputs()),
-      physics_(plant.n_inputs() * plant.n_outputs()) {
+      physics_(plant.n_inputs() * plant.n_outputs()),
+      scan_input_(plant.n_outputs(), -1) {
   if (settings.diagnosis_window > 0) {
     diagnosis_ = std::make_unique<DiagnosisWorker>(plant, static_cast<std::size_t>(settings.diagnosis_window));
     const ScanSettings scan = scan_settings(settings);
@@ -165,6 +166,7 @@ void MonitorService::publish_scan_alarm(std::size_t output, bool raised) {
   const DiagnosisWorker::LookResult& r = look_result_;
   // The finding's input on the output (-1: none, e.g. a disturbance model).
   const long input = raised && r.inputs[output] ? static_cast<long>(*r.inputs[output]) : -1;
+  scan_input_[output] = input;
   alarm_.controller_id = settings_.controller_id;
   alarm_.utime = r.look.utime;
   alarm_.sample_sequence = r.look.seq;
@@ -188,6 +190,7 @@ void MonitorService::publish_scan_alarm(std::size_t output, bool raised) {
     diagnosis_msg_.window = static_cast<std::int32_t>(r.look.rows);
     alarm_.physics = diagnosis_msg_.physics;
     alarm_.text = "diagnosis scan: raised " + alarm_.output + ": " + diagnosis_msg_.text;
+    if (input >= 0) physics_[output * plant_.n_inputs() + static_cast<std::size_t>(input)] = diagnosis_msg_.physics;
   } else {
     alarm_.physics.clear();
     alarm_.text = "diagnosis scan: cleared " + alarm_.output + ": no finding on it in " +
@@ -228,7 +231,11 @@ void MonitorService::step(const double* u, const double* y, const double* sim_y)
 
 void MonitorService::check_alarms(const msg::Sample& s) {
   edges_.scan(monitor_, [&](std::size_t j, std::size_t i, bool raised) {
-    if (raised) physics_[j * plant_.n_inputs() + i].clear();  // a new episode: its physics is not known yet
+    // A new episode: its physics is not known yet, unless the scan has this
+    // output raised with a finding on this very channel (the same episode,
+    // its word already found).
+    const bool scan_named_it = scan_.enabled() && scan_.raised(j) && scan_input_[j] == static_cast<long>(i);
+    if (raised && !scan_named_it) physics_[j * plant_.n_inputs() + i].clear();
     publish_alarm(j, i, s);
     if (raised && diagnosis_) diagnosis_->request({j, i, alarm_.utime, s.seq, settings_.controller_id});
   });
@@ -308,7 +315,8 @@ void MonitorService::publish_alarm(std::size_t output, std::size_t input, const 
   alarm_.p_value = f.p_value;
   alarm_.gamma = f.gamma;
   // Known once the diagnosis that a raise asks for has finished: empty in the
-  // raise itself (the diagnosis message follows it), filled in later alarms.
+  // raise itself (the diagnosis message follows it), filled in later alarms;
+  // known at once when the scan has already named this channel.
   alarm_.physics = physics_[output * plant_.n_inputs() + input];
   char text[320];
   if (f.raised) {

@@ -180,6 +180,7 @@ class MonitorService {
   msg::Alarm alarm_;
   std::unique_ptr<DiagnosisWorker> diagnosis_;  // null when diagnosis_window = 0
   std::vector<std::string> physics_;           // per channel: the last diagnosis' physics word
+  std::vector<long> scan_input_;               // per output the scan has raised: its finding's input (-1: none)
   msg::Diagnosis diagnosis_msg_;
   DiagnosisScan scan_;                         // off without diagnosis_
   bool look_due_ = false;                      // a checkpoint passed in this sample's steps
