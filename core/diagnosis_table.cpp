@@ -83,7 +83,10 @@ const std::array<Hypothesis, 16> kTable{{
 // that cools); an integrator against the channel's gain likewise; a lag's
 // pole outside [0, 1) is no first-order lag (negative: it rings; at or past
 // one: it does not settle); a time or width must be positive and a dead
-// time not negative. Empty when plausible.
+// time not negative. Empty when plausible. A recorded signal's gain has no
+// sign to check: the record does not say which way the signal counts (a
+// reflux temperature lowers a purity, a feed flow through a negative channel
+// raises it), so its fitted sign is reported, not judged.
 std::string implausibility(const Finding& f, const Facts& x) {
   for (const auto& [name, v] : f.parameters) {
     const std::string_view n = name;
