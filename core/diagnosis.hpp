@@ -118,7 +118,8 @@ struct Finding {
   int params = 0;
   // Other words on the same channels that the data cannot tell from
   // `physics` (they pass every test and their selection score is within
-  // kAliasMargin of this one's), best first. The word reported is the best.
+  // max(3.84, 3 % of this one's): alternatives() in diagnosis.cpp), best
+  // first. The word reported is the best.
   std::vector<std::string> alternatives;
   // Why a fitted parameter is physically impossible or has the wrong sign
   // (a gain that reverses the channel: a heater that cools); empty when
