@@ -173,6 +173,43 @@ Finding monitor_fallback(const Context& cx, std::size_t j) {
   return f;
 }
 
+// How close in selection score (a deviance: BIC on the fit part plus the
+// held-out log-likelihood gain) another word must come to be an alternative:
+// the larger of 3.84 (the 95 % chi-square(1) quantile) and 3 % of the chosen
+// score, the spread within which gain and time constant were seen to trade
+// places on records the project had not seen (issue 13).
+constexpr double kAliasAbsolute = 3.84;
+constexpr double kAliasRelative = 0.03;
+
+// The words the data cannot tell from the chosen candidate: other words on
+// the same channels (and signal) that pass every test and score within the
+// margin, best first, each once. The chosen word is not changed.
+std::vector<std::string> alternatives(const Context& cx, const Candidate& best, const std::vector<Candidate>& cands,
+                                      double family, double log_n) {
+  const auto key = [](const Finding& f) {
+    std::vector<std::pair<std::size_t, long>> k;
+    for (const auto& c : f.channels) k.push_back({c.output, c.input ? static_cast<long>(*c.input) : -1});
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  const auto chans = key(best.finding);
+  const double top = selection_score(cx, best, log_n);
+  const double margin = std::max(kAliasAbsolute, kAliasRelative * std::abs(top));
+  std::vector<std::pair<double, std::string>> near;
+  for (const auto& c : cands) {
+    if (c.finding.physics == best.finding.physics || c.finding.signal != best.finding.signal ||
+        key(c.finding) != chans || !passes(c, cx.settings, family))
+      continue;
+    const double score_c = selection_score(cx, c, log_n);
+    if (top - score_c <= margin) near.push_back({score_c, c.finding.physics});
+  }
+  std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<std::string> out;
+  for (auto& n : near)
+    if (std::find(out.begin(), out.end(), n.second) == out.end()) out.push_back(std::move(n.second));
+  return out;
+}
+
 }  // namespace
 
 Result diagnose(const Problem& problem, const Settings& settings, Progress progress) {
@@ -214,9 +251,11 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
       }
     }
     if (!best) break;
+    std::vector<std::string> alias = alternatives(cx, *best, cands, family, log_n);
     const Candidate chosen = rebuild_chosen(cx, groups, *best);
     best = &chosen;
     Finding f = best->finding;
+    f.alternatives = std::move(alias);
     f.fit = fit_numbers(cx, *best, f.raw);
     for (const auto& ch : f.channels) {
       if (ch.input) used.insert({ch.output, static_cast<long>(*ch.input)});

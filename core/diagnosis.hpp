@@ -116,6 +116,15 @@ struct Finding {
   FitNumbers raw;   // the raw residual's variances, for the record
   double lr = 0.0;  // likelihood-ratio statistic on the fit part
   int params = 0;
+  // Other words on the same channels that the data cannot tell from
+  // `physics` (they pass every test and their selection score is within
+  // max(3.84, 3 % of this one's): alternatives() in diagnosis.cpp), best
+  // first. The word reported is the best.
+  std::vector<std::string> alternatives;
+  // Why a fitted parameter is physically impossible or has the wrong sign
+  // (a gain that reverses the channel: a heater that cools); empty when
+  // plausible. The rules are implausibility() in diagnosis_table.cpp.
+  std::string implausible;
 };
 
 struct Result {

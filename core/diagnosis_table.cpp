@@ -4,6 +4,7 @@
 #include "core/diagnosis_table.hpp"
 
 #include <array>
+#include <string_view>
 
 namespace mpm::diagnosis {
 namespace {
@@ -76,6 +77,33 @@ const std::array<Hypothesis, 16> kTable{{
      say_disturbance_model},
 }};
 
+// The plausibility rules, for every row: a fitted value that no physical
+// plant has. A gain factor (the channel's, or the linear term of a static
+// map) at or below zero reverses or removes the channel's sign (a heater
+// that cools); an integrator against the channel's gain likewise; a lag's
+// pole outside [0, 1) is no first-order lag (negative: it rings; at or past
+// one: it does not settle); a time or width must be positive and a dead
+// time not negative. Empty when plausible. A recorded signal's gain has no
+// sign to check: the record does not say which way the signal counts (a
+// reflux temperature lowers a purity, a feed flow through a negative channel
+// raises it), so its fitted sign is reported, not judged.
+std::string implausibility(const Finding& f, const Facts& x) {
+  for (const auto& [name, v] : f.parameters) {
+    const std::string_view n = name;
+    if (n.starts_with("gain_factor") && v <= 0.0)
+      return "the fitted " + name + " " + fmt(v) + " reverses the channel's sign";
+    if (n.ends_with("_pole") && (v < 0.0 || v >= 1.0))
+      return "the fitted " + name + " " + fmt(v) + " is outside [0, 1)";
+    if ((n.ends_with("_time_constant") || n == "time_constant_ratio" || n == "backlash_width") && v <= 0.0)
+      return "the fitted " + name + " " + fmt(v) + " is not positive";
+  }
+  if (const auto g = x.find("gain_ratio"); g != x.end() && g->second <= 0.0)
+    return "the fitted gain ratio " + fmt(g->second) + " makes the integrator act against the channel's sign";
+  if (f.fitted && f.fitted->delay < 0)
+    return "the fitted dead time " + std::to_string(f.fitted->delay) + " samples is negative";
+  return {};
+}
+
 }  // namespace
 
 std::span<const Hypothesis> hypothesis_table() { return kTable; }
@@ -85,8 +113,12 @@ void run_scope(const Context& cx, Scope scope, const Site& site, std::vector<Can
     if (h.scope != scope || !h.applies(cx, site)) continue;
     const std::size_t first = out.size();
     h.fit(cx, h, site, out);
-    for (std::size_t k = first; k < out.size(); ++k)
-      out[k].finding.summary = h.sentence(cx.problem, out[k].finding, out[k].facts);
+    for (std::size_t k = first; k < out.size(); ++k) {
+      Finding& f = out[k].finding;
+      f.summary = h.sentence(cx.problem, f, out[k].facts);
+      f.implausible = implausibility(f, out[k].facts);
+      if (!f.implausible.empty()) f.summary += " (implausible: " + f.implausible + ")";
+    }
   }
 }
 

@@ -87,7 +87,9 @@ std::string finding_json(const PlantModel& plant, const diagnosis::Finding& f) {
     << ", \"residual_variance_after\": " << number(f.raw.residual_variance_after)
     << ", \"holdout_variance_before\": " << number(f.raw.holdout_variance_before)
     << ", \"holdout_variance_after\": " << number(f.raw.holdout_variance_after) << "},\n      \"likelihood_ratio\": "
-    << number(f.lr) << ",\n      \"parameters\": " << f.params << "\n    }";
+    << number(f.lr) << ",\n      \"parameters\": " << f.params << ",\n      \"alternatives\": [";
+  for (std::size_t a = 0; a < f.alternatives.size(); ++a) o << (a ? ", " : "") << quoted(f.alternatives[a]);
+  o << "],\n      \"implausible\": " << (f.implausible.empty() ? "null" : quoted(f.implausible)) << "\n    }";
   return o.str();
 }
 

@@ -63,6 +63,7 @@ TEST(DiagnosisThreads, SameFindingsOnOneThreadOrSeveral) {
     EXPECT_EQ(x.fit.residual_variance_after, y.fit.residual_variance_after);
     EXPECT_EQ(x.raw.holdout_variance_after, y.raw.holdout_variance_after);
     EXPECT_EQ(x.parameters, y.parameters);
+    EXPECT_EQ(x.alternatives, y.alternatives);
     ASSERT_EQ(x.fitted.has_value(), y.fitted.has_value());
     if (x.fitted) {
       EXPECT_EQ(x.fitted->num, y.fitted->num);
