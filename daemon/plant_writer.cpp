@@ -157,6 +157,11 @@ CorrectedPlant apply_findings(const PlantModel& plant, const diagnosis::Result& 
   c.why.assign(plant.channels.size(), {});
   c.noise_why.assign(plant.n_outputs(), {});
   for (const diagnosis::Finding& f : result.findings) {
+    if (!f.implausible.empty()) {
+      c.held_back.push_back(reason(f));
+      c.written.push_back(Written::kImplausible);
+      continue;
+    }
     const bool one_channel = f.channels.size() == 1 && f.channels[0].input.has_value();
     if (is_channel_physics(f) && one_channel && f.fitted) {
       apply_channel(c, f, f.channels[0]);
@@ -174,8 +179,10 @@ CorrectedPlant apply_findings(const PlantModel& plant, const diagnosis::Result& 
       c.noise_why[j].push_back(reason(f));
     } else {
       c.not_applied.push_back(reason(f));
+      c.written.push_back(Written::kNotExpressible);
       continue;
     }
+    c.written.push_back(Written::kApplied);
     ++c.changes;
   }
   return c;
@@ -194,6 +201,8 @@ std::string plant_yaml(const CorrectedPlant& c, const std::string& source_plant,
          "# change is exact in continuous form too.\n";
   for (const std::string& s : c.not_applied)
     o += "# NOT applied (the plant format cannot express it): " + s + "\n";
+  for (const std::string& s : c.held_back)
+    o += "# NOT applied (implausible: judge it before using it): " + s + "\n";
   o += "plant: " + scalar(p.name.empty() ? std::string("corrected") : p.name) + "\n";
   o += "sample_time: " + num(p.sample_time) + "\n";
   o += "inputs: " + names(p.inputs) + "\n";

@@ -7,6 +7,8 @@
 // than it holds.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,11 +18,20 @@
 
 namespace mpm {
 
+// What became of one finding in the corrected plant file.
+enum class Written : std::uint8_t {
+  kApplied,
+  kNotExpressible,  // the plant format cannot express it
+  kImplausible,     // flagged implausible (a heater that cools): held back for a person to judge
+};
+
 struct CorrectedPlant {
   PlantModel plant;                        // the corrected model
   std::vector<std::vector<std::string>> why;  // per plant.channels entry: the findings that changed it
   std::vector<std::vector<std::string>> noise_why;  // per output
   std::vector<std::string> not_applied;     // findings the format cannot express
+  std::vector<std::string> held_back;       // findings flagged implausible, not applied
+  std::vector<Written> written;             // per finding of the result, in its order
   std::size_t changes = 0;                  // channel or noise entries changed
 };
 
@@ -31,6 +42,7 @@ struct CorrectedPlant {
 // first where its parameters allow: a gain factor, an extra delay, an extra
 // lag); actuator / sensor dynamics put the fitted lag in series with every
 // channel of that input / output; disturbance_model replaces that output's N.
+// A finding flagged implausible is not applied: the file says why.
 CorrectedPlant apply_findings(const PlantModel& plant, const diagnosis::Result& result);
 
 // The corrected plant as YAML text. Channels left unchanged keep the

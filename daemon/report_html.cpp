@@ -362,13 +362,14 @@ std::string report_html(const ReportInputs& in) {
             "<th>held-out variance before \u2192 after</th><th>written to the plant file</th></tr>\n";
     for (std::size_t k = 0; k < in.result.findings.size(); ++k) {
       const auto& f = in.result.findings[k];
-      const bool applied = std::none_of(in.corrected.not_applied.begin(), in.corrected.not_applied.end(),
-                                        [&](const std::string& s) { return s.rfind(f.physics + ": " + f.summary, 0) == 0; });
+      const Written written = k < in.corrected.written.size() ? in.corrected.written[k] : Written::kNotExpressible;
       body << "<tr><td>" << k + 1 << "</td><td>" << esc(arrow(in, f)) << "</td><td><b>" << esc(f.physics) << "</b>";
       for (std::size_t a = 0; a < f.alternatives.size(); ++a) body << (a ? ", " : " (or ") << esc(f.alternatives[a]);
       body << (f.alternatives.empty() ? "" : ")") << "</td><td>" << esc(f.summary) << "</td><td>"
            << num(f.fit.holdout_variance_before) << " \u2192 "
-           << num(f.fit.holdout_variance_after) << "</td><td>" << (applied ? "yes" : "no (not expressible)")
+           << num(f.fit.holdout_variance_after) << "</td><td>"
+           << (written == Written::kApplied ? "yes"
+               : written == Written::kImplausible ? "no (implausible)" : "no (not expressible)")
            << "</td></tr>\n";
     }
     body << "</table>\n";

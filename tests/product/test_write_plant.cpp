@@ -98,6 +98,39 @@ TEST(WritePlant, ComposesFindingsAndReadsBack) {
   ASSERT_TRUE(back.operating_point.has_value() == nominal.operating_point.has_value());
 }
 
+// A fit flagged implausible (a channel whose sign the fit reversed) is held
+// back: the file says so and the channel keeps its nominal model.
+TEST(WritePlant, AnImplausibleFindingIsHeldBack) {
+  const mpm::PlantModel nominal = mpm::config::load_plant(kWoodBerryContinuous);
+  mpm::diagnosis::Result r;
+  r.mismatch = true;
+  auto reversed = finding("gain", {{1, 0}}, {{"gain_factor", -0.6}});
+  reversed.fitted = channel(nominal, 1, 0).tf;
+  for (double& b : reversed.fitted->num) b *= -0.6;
+  reversed.implausible = "the fitted gain factor -0.6 reverses the channel's sign";
+  r.findings.push_back(reversed);
+  auto plain = finding("gain", {{0, 1}}, {{"gain_factor", 1.2}});
+  plain.fitted = channel(nominal, 0, 1).tf;
+  for (double& b : plain.fitted->num) b *= 1.2;
+  r.findings.push_back(plain);
+
+  const mpm::CorrectedPlant c = mpm::apply_findings(nominal, r);
+  EXPECT_EQ(c.changes, 1u);
+  ASSERT_EQ(c.written.size(), 2u);
+  EXPECT_EQ(c.written[0], mpm::Written::kImplausible);
+  EXPECT_EQ(c.written[1], mpm::Written::kApplied);
+  const std::string yaml = mpm::plant_yaml(c, kWoodBerryContinuous, "run.csv");
+  EXPECT_NE(yaml.find("NOT applied (implausible: judge it before using it): gain: planted gain"), std::string::npos)
+      << yaml;
+  const std::string path = tmp("corrected.yaml");
+  mpm::write_text_file(path, yaml, {kWoodBerryContinuous});
+  const mpm::PlantModel back = mpm::config::load_plant(path);
+  expect_tf_near(channel(back, 1, 0).tf, channel(nominal, 1, 0).tf);  // held back: nominal
+  mpm::DiscreteTf g12 = channel(nominal, 0, 1).tf;
+  for (double& b : g12.num) b *= 1.2;
+  expect_tf_near(channel(back, 0, 1).tf, g12);  // applied
+}
+
 TEST(WritePlant, RefusesToOverwriteAnInput) {
   const std::string plant = tmp("plant.yaml"), csv = tmp("run.csv");
   std::filesystem::copy_file(kWoodBerry, plant, std::filesystem::copy_options::overwrite_existing);
