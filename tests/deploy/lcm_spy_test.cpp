@@ -85,6 +85,12 @@ std::optional<Row> wait_row(const ChildProcess& spy, const std::string& channel)
   return row(spy.stdout_text(), channel);
 }
 
+// Decoded by lcm-spy as our `type`, nothing undecodable.
+void expect_decoded(const Row& r, const std::string& type) {
+  EXPECT_EQ(r.type, type) << r.channel;
+  EXPECT_EQ(r.undecodable, 0) << r.channel;
+}
+
 // Double-clicks `r` in lcm-spy's channel table (on `display`) until its viewer opens.
 bool open_viewer(const std::string& display, const ChildProcess& spy, const Row& r) {
   const std::string click = "DISPLAY=" + display + " xdotool mousemove " + std::to_string(r.x) + " " +
@@ -166,36 +172,28 @@ TEST(LcmSpy, ShowsOurAlarmsDecoded) {
   ASSERT_TRUE(obs.wait_alarms([](const auto& a) { return !a.empty(); }, std::chrono::seconds(10)));
 
   // lcm-spy decoded it: our type name, nothing undecodable.
-  const std::optional<Row> found_alarm = wait_row(spy, "MPM_ALARM");
-  ASSERT_TRUE(found_alarm) << spy.stdout_text();
-  const Row alarm = *found_alarm;
-  EXPECT_EQ(alarm.type, "alarm_t");
-  EXPECT_GE(alarm.messages, 1);
-  EXPECT_EQ(alarm.undecodable, 0);
-  const Row status = *row(spy.stdout_text(), "MPM_STATUS");
-  EXPECT_EQ(status.type, "status_t");
-  EXPECT_EQ(status.undecodable, 0);
-  const Row sample = *row(spy.stdout_text(), "MPM_SAMPLE");
-  EXPECT_EQ(sample.type, "sample_t");
-  EXPECT_EQ(sample.undecodable, 0);
+  const std::optional<Row> alarm = wait_row(spy, "MPM_ALARM");
+  ASSERT_TRUE(alarm) << spy.stdout_text();
+  expect_decoded(*alarm, "alarm_t");
+  EXPECT_GE(alarm->messages, 1);
+  expect_decoded(*row(spy.stdout_text(), "MPM_STATUS"), "status_t");
+  expect_decoded(*row(spy.stdout_text(), "MPM_SAMPLE"), "sample_t");
 
   // Open the alarm's viewer as an operator would, and keep a picture of it.
-  ASSERT_TRUE(open_viewer(display, spy, alarm)) << spy.stdout_text();
+  ASSERT_TRUE(open_viewer(display, spy, *alarm)) << spy.stdout_text();
   ASSERT_TRUE(screenshot(display, kScreenshot));
   std::printf("screenshot: %s\n", kScreenshot.c_str());
 
   // The diagnosis that follows the raise: decoded as diagnosis_t.
   ASSERT_TRUE(eventually([&] { return !obs.diagnoses().empty(); })) << mpmd.stderr_text();
-  const std::optional<Row> found_diagnosis = wait_row(spy, "MPM_DIAGNOSIS");
-  ASSERT_TRUE(found_diagnosis) << spy.stdout_text();
-  const Row diagnosis = *found_diagnosis;
-  EXPECT_EQ(diagnosis.type, "diagnosis_t");
-  EXPECT_GE(diagnosis.messages, 1);
-  EXPECT_EQ(diagnosis.undecodable, 0);
+  const std::optional<Row> diagnosis = wait_row(spy, "MPM_DIAGNOSIS");
+  ASSERT_TRUE(diagnosis) << spy.stdout_text();
+  expect_decoded(*diagnosis, "diagnosis_t");
+  EXPECT_GE(diagnosis->messages, 1);
   // The alarm's viewer opened over the channel table (no window manager
   // here): hide it so the double-click reaches the table.
   std::system(("DISPLAY=" + display + " xdotool search --name '^MPM_ALARM$' windowunmap >/dev/null 2>&1").c_str());
-  ASSERT_TRUE(open_viewer(display, spy, diagnosis)) << spy.stdout_text();
+  ASSERT_TRUE(open_viewer(display, spy, *diagnosis)) << spy.stdout_text();
   ASSERT_TRUE(screenshot(display, kDiagnosisScreenshot));
   std::printf("screenshot: %s (%s)\n", kDiagnosisScreenshot.c_str(), obs.diagnoses().front().text.c_str());
 
