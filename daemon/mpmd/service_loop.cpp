@@ -113,6 +113,18 @@ void ServiceLoop::feed_watchdog(Clock::time_point now) {
   next_watchdog_ = now + *wd;
 }
 
+// The running configuration stays. A different error is news to the operator
+// who just edited the file: reported whatever the throttle says (a storm
+// repeats one error).
+void ServiceLoop::reload_failed(const std::string& error, bool report, const char* suppressed) {
+  if (report || error != last_reload_error_) {
+    log::write(log::Level::kError, "reload failed, keeping the running configuration: %s%s", error.c_str(),
+               suppressed);
+    last_reload_error_ = error;
+  }
+  notifier_.ready("reload failed; running the previous configuration");
+}
+
 // A SIGHUP storm must not flood the journal: the lines of a reload are
 // rate-limited like every other kind of log line (the first at once, then
 // at most one per log_interval, saying how many reloads were not reported);
@@ -130,14 +142,7 @@ void ServiceLoop::apply_reload() {
   std::string error;
   auto next = load_config(config_path_, error);
   if (!next) {
-    // A different error is news to the operator who just edited the file:
-    // reported whatever the throttle says (a storm repeats one error).
-    if (report || error != last_reload_error_) {
-      log::write(log::Level::kError, "reload failed, keeping the running configuration: %s%s", error.c_str(),
-                 suppressed);
-      last_reload_error_ = error;
-    }
-    notifier_.ready("reload failed; running the previous configuration");
+    reload_failed(error, report, suppressed);
     return;
   }
   const auto& was = running_.config.transport;
@@ -150,12 +155,7 @@ void ServiceLoop::apply_reload() {
   if (!next->same_monitor(running_)) {
     auto service = make_service(*next, service_->alarm_sink(), error);
     if (!service) {
-      if (report || error != last_reload_error_) {
-        log::write(log::Level::kError, "reload failed, keeping the running configuration: %s%s", error.c_str(),
-                   suppressed);
-        last_reload_error_ = error;
-      }
-      notifier_.ready("reload failed; running the previous configuration");
+      reload_failed(error, report, suppressed);
       return;
     }
     service_->retire("reloaded with new settings");

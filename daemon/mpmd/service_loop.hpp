@@ -40,6 +40,7 @@ class ServiceLoop {
   void publish_status(Clock::time_point now);
   void feed_watchdog(Clock::time_point now);
   void apply_reload();
+  void reload_failed(const std::string& error, bool report, const char* suppressed);
   void write_checkpoint(Clock::time_point now, bool final_one);
   void wait(Clock::time_point until);
 

@@ -1,6 +1,6 @@
 // The shared update of a full model and its pairwise models (NestedRls)
 // against separate square-root RLS fits of each model on the same rows
-// (SqrtRls, itself checked against batch QR in test_sqrt_rls.cpp).
+// (SqrtRls, itself checked against batch QR in test_rls_factors.cpp).
 #include <cmath>
 #include <random>
 #include <vector>

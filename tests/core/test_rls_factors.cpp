@@ -14,6 +14,7 @@ namespace {
 
 using test::BatchQr;
 using test::DataGen;
+using test::feed;
 using test::kDelta;
 using test::range_except;
 
@@ -27,16 +28,10 @@ TYPED_TEST(RecursiveFactor, EqualsBatchAfterAMillionSamples) {
   TypeParam rls(p, 1.0, kDelta);
   BatchQr batch(p);
   DataGen gen(p);
-  const int n = 1'000'000, block = 20'000;
-  Eigen::MatrixXd rows(block, p + 1);
-  Eigen::VectorXd x(p);
-  double y = 0;
-  for (int k = 0; k < n; ++k) {
-    gen.next(x, y);
-    rls.update(x.data(), y);
-    rows.row(k % block).head(p) = x.transpose();
-    rows(k % block, p) = y;
-    if ((k + 1) % block == 0) batch.add_block(rows);
+  Eigen::MatrixXd rows(20'000, p + 1);
+  for (int b = 0; b < 50; ++b) {  // a million samples, the batch fed a block at a time
+    feed(rls, gen, rows);
+    batch.add_block(rows);
   }
   const auto rel = [](double a, double b) { return std::abs(a - b) / std::abs(b); };
   EXPECT_LT(rel(rls.rss(), batch.rss(range_except(p, p, 0))), 1e-8);
@@ -56,19 +51,31 @@ TYPED_TEST(RecursiveFactor, ForgettingEqualsWeightedBatch) {
   DataGen gen(p);
   const int n = 2000;
   Eigen::MatrixXd rows(n, p + 1);
-  Eigen::VectorXd x(p);
-  double y = 0;
-  for (int k = 0; k < n; ++k) {
-    gen.next(x, y);
-    rls.update(x.data(), y);
-    rows.row(k).head(p) = x.transpose();
-    rows(k, p) = y;
-  }
+  feed(rls, gen, rows);
   for (int k = 0; k < n; ++k) rows.row(k) *= std::sqrt(std::pow(lambda, n - 1 - k));
   BatchQr batch(p);  // its prior is ~delta (the kept-alive prior is of the same size)
   batch.add_block(rows);
   EXPECT_NEAR(rls.rss() / batch.rss(range_except(p, p, 0)), 1.0, 1e-9);
   EXPECT_NEAR(rls.rss_prefix(2) / batch.rss(range_except(2, 2, 0)), 1.0, 1e-9);
+}
+
+// The conditional RSS by re-triangularisation on every block, against batch
+// least squares on every subset.
+TYPED_TEST(RecursiveFactor, RssWithoutEveryBlockMatchesBatchOnSubsets) {
+  const int p = 12;
+  TypeParam rls(p, 1.0, kDelta);
+  BatchQr batch(p);
+  DataGen gen(p);
+  Eigen::MatrixXd rows(3000, p + 1);
+  feed(rls, gen, rows);
+  batch.add_block(rows);
+  typename TypeParam::Matrix scratch(p + 1, p + 1);
+  for (int first = 0; first < p; ++first)
+    for (int count = 1; first + count <= p; ++count) {
+      const double ref = batch.rss(range_except(p, first, count));
+      EXPECT_NEAR(rls.rss_without(static_cast<std::size_t>(first), static_cast<std::size_t>(count), scratch) / ref, 1.0, 1e-10)
+          << first << "+" << count;
+    }
 }
 
 TYPED_TEST(RecursiveFactor, StaysBoundedWithoutExcitation) {

@@ -87,48 +87,44 @@ std::int64_t unix_micros() {
 bool restarted(const msg::Status& s, std::int64_t after) { return s.utime >= after; }
 
 TEST_P(CheckpointTest, SigkillMidRunResumesTheStatisticsAndTheAlarm) {
-  auto t = make_transport();
-  ASSERT_TRUE(t);
-  Observer obs(*t);
-  const std::string config = config_with_checkpoint();
-  auto mpmd = start_mpmd(config, "first");
-  ASSERT_TRUE(obs.wait_status("wb", [](const msg::Status&) { return true; })) << mpmd->stderr_text();
+  Session run = open_session(config_with_checkpoint(), "wb", 0, "first");
+  ASSERT_TRUE(run.up) << run.log();
   Controller c("wb", 21);
   std::vector<msg::Sample> sent;
 
   // Matched, then G21 x 1.5 until u1 -> y2 is raised and a checkpoint holds it.
-  ASSERT_TRUE(publish(*t, obs, c, 600, sent));
+  ASSERT_TRUE(publish(*run.t, *run.obs, c, 600, sent));
   c.stream.set_g21_gain(1.5);
-  for (int k = 0; k < 30 && obs.alarms().empty(); ++k) ASSERT_TRUE(publish(*t, obs, c, 50, sent));
-  ASSERT_TRUE(obs.wait_alarms([](const auto& a) { return !a.empty(); }, std::chrono::seconds(10)));
-  const auto raised_at = static_cast<std::uint64_t>(obs.alarms().front().sample_sequence);
-  ASSERT_TRUE(publish(*t, obs, c, 200, sent));
-  ASSERT_TRUE(eventually([&] { return checkpointed(config) > raised_at; })) << mpmd->stderr_text();
+  for (int k = 0; k < 30 && run.obs->alarms().empty(); ++k) ASSERT_TRUE(publish(*run.t, *run.obs, c, 50, sent));
+  ASSERT_TRUE(run.obs->wait_alarms([](const auto& a) { return !a.empty(); }, std::chrono::seconds(10)));
+  const auto raised_at = static_cast<std::uint64_t>(run.obs->alarms().front().sample_sequence);
+  ASSERT_TRUE(publish(*run.t, *run.obs, c, 200, sent));
+  ASSERT_TRUE(eventually([&] { return checkpointed(run.config) > raised_at; })) << run.mpmd->stderr_text();
 
   // More samples in flight, then SIGKILL: what came after the last checkpoint is lost.
   for (int k = 0; k < 100; ++k) {
     sent.push_back(c.next());
-    ASSERT_TRUE(t->publish(c.sample));
+    ASSERT_TRUE(run.t->publish(c.sample));
   }
-  mpmd->signal(SIGKILL);
-  ASSERT_TRUE(mpmd->wait_exit(std::chrono::seconds(10)).has_value());
+  run.mpmd->signal(SIGKILL);
+  ASSERT_TRUE(run.mpmd->wait_exit(std::chrono::seconds(10)).has_value());
   const std::int64_t killed = unix_micros();
-  const std::uint64_t resumed_at = checkpointed(config);
+  const std::uint64_t resumed_at = checkpointed(run.config);
   ASSERT_GT(resumed_at, raised_at);
-  const std::size_t alarms_before = obs.alarms().size();
+  const std::size_t alarms_before = run.obs->alarms().size();
 
-  auto second = start_mpmd(config, "second");
-  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return restarted(s, killed); }))
+  auto second = start_mpmd(run.config, "second");
+  ASSERT_TRUE(run.obs->wait_status("wb", [&](const msg::Status& s) { return restarted(s, killed); }))
       << second->stderr_text();
-  const msg::Status resumed = *obs.status("wb");
+  const msg::Status resumed = *run.obs->status("wb");
   EXPECT_EQ(static_cast<std::uint64_t>(resumed.samples_seen), resumed_at);
-  const double at_resume = compare_status(resumed, reference(config, sent, resumed_at));
+  const double at_resume = compare_status(resumed, reference(run.config, sent, resumed_at));
   EXPECT_LE(at_resume, 1e-12);
   EXPECT_EQ(resumed.alarms_raised, 1);
   EXPECT_EQ(count_lines(second->stderr_text(), "resumed from checkpoint"), 1) << second->stderr_text();
   // The raised alarm is said again by the new process.
-  ASSERT_TRUE(obs.wait_alarms([&](const auto& a) { return a.size() > alarms_before; }, std::chrono::seconds(10)));
-  const msg::Alarm again = obs.alarms()[alarms_before];
+  ASSERT_TRUE(run.obs->wait_alarms([&](const auto& a) { return a.size() > alarms_before; }, std::chrono::seconds(10)));
+  const msg::Alarm again = run.obs->alarms()[alarms_before];
   EXPECT_TRUE(again.raised && again.output == "y2" && again.input == "u1") << again.text;
   EXPECT_NE(again.text.find("still raised"), std::string::npos) << again.text;
 
@@ -137,15 +133,15 @@ TEST_P(CheckpointTest, SigkillMidRunResumesTheStatisticsAndTheAlarm) {
   c.seq = static_cast<std::int64_t>(resumed_at);
   c.sent = c.seq;
   for (std::size_t k = resumed_at; k < sent.size(); ++k) {
-    ASSERT_TRUE(t->publish(sent[k]));
+    ASSERT_TRUE(run.t->publish(sent[k]));
     ++c.seq;
     ++c.sent;
   }
   c.sample = sent.back();
-  ASSERT_TRUE(sync(obs, c));
-  ASSERT_TRUE(publish(*t, obs, c, 300, sent));
-  const msg::Status end = *obs.status("wb");
-  const double at_end = compare_status(end, reference(config, sent, sent.size()));
+  ASSERT_TRUE(sync(*run.obs, c));
+  ASSERT_TRUE(publish(*run.t, *run.obs, c, 300, sent));
+  const msg::Status end = *run.obs->status("wb");
+  const double at_end = compare_status(end, reference(run.config, sent, sent.size()));
   EXPECT_LE(at_end, 1e-12);
   std::printf("SIGKILL after %zu samples, checkpoint at %llu: largest relative difference %.3g at resume, "
               "%.3g after %zu samples\n",
@@ -155,22 +151,18 @@ TEST_P(CheckpointTest, SigkillMidRunResumesTheStatisticsAndTheAlarm) {
   second->signal(SIGTERM);
   EXPECT_EQ(second->wait_exit(std::chrono::seconds(20)), 0);
   EXPECT_EQ(count_lines(second->stderr_text(), "state saved to"), 1) << second->stderr_text();
-  EXPECT_EQ(checkpointed(config), sent.size());
+  EXPECT_EQ(checkpointed(run.config), sent.size());
 }
 
 TEST_P(CheckpointTest, AChangedPlantOrADamagedFileStartsFresh) {
-  auto t = make_transport();
-  ASSERT_TRUE(t);
-  Observer obs(*t);
-  const std::string config = config_with_checkpoint();
-  auto first = start_mpmd(config, "first");
-  ASSERT_TRUE(obs.wait_status("wb", [](const msg::Status&) { return true; })) << first->stderr_text();
+  Session run = open_session(config_with_checkpoint(), "wb", 0, "first");
+  ASSERT_TRUE(run.up) << run.log();
   Controller c("wb", 22);
   std::vector<msg::Sample> sent;
-  ASSERT_TRUE(publish(*t, obs, c, 300, sent));
-  first->signal(SIGTERM);
-  ASSERT_EQ(first->wait_exit(std::chrono::seconds(20)), 0);
-  ASSERT_EQ(checkpointed(config), 300u);
+  ASSERT_TRUE(publish(*run.t, *run.obs, c, 300, sent));
+  run.mpmd->signal(SIGTERM);
+  ASSERT_EQ(run.mpmd->wait_exit(std::chrono::seconds(20)), 0);
+  ASSERT_EQ(checkpointed(run.config), 300u);
   std::int64_t stopped = unix_micros();
 
   // The same plant with G21's gain changed: another model, so a fresh start.
@@ -178,10 +170,10 @@ TEST_P(CheckpointTest, AChangedPlantOrADamagedFileStartsFresh) {
   plant.replace(plant.find("num: [0.5786]"), 13, "num: [0.6000]");
   dir().write("changed-plant.yaml", plant);
   config_with_checkpoint(dir().file("changed-plant.yaml"));
-  auto second = start_mpmd(config, "second");
-  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return restarted(s, stopped); }))
+  auto second = start_mpmd(run.config, "second");
+  ASSERT_TRUE(run.obs->wait_status("wb", [&](const msg::Status& s) { return restarted(s, stopped); }))
       << second->stderr_text();
-  EXPECT_EQ(obs.status("wb")->samples_seen, 0);
+  EXPECT_EQ(run.obs->status("wb")->samples_seen, 0);
   EXPECT_EQ(count_lines(second->stderr_text(), "written for another plant file"), 1) << second->stderr_text();
   EXPECT_EQ(count_lines(second->stderr_text(), "starting fresh"), 1) << second->stderr_text();
   second->signal(SIGTERM);
@@ -191,10 +183,10 @@ TEST_P(CheckpointTest, AChangedPlantOrADamagedFileStartsFresh) {
   // A truncated checkpoint: refused, fresh start.
   const std::string state = dir().file("mpmd.state");
   std::filesystem::resize_file(state, std::filesystem::file_size(state) / 2);
-  auto third = start_mpmd(config, "third");
-  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return restarted(s, stopped); }))
+  auto third = start_mpmd(run.config, "third");
+  ASSERT_TRUE(run.obs->wait_status("wb", [&](const msg::Status& s) { return restarted(s, stopped); }))
       << third->stderr_text();
-  EXPECT_EQ(obs.status("wb")->samples_seen, 0);
+  EXPECT_EQ(run.obs->status("wb")->samples_seen, 0);
   EXPECT_EQ(count_lines(third->stderr_text(), "refused, starting fresh"), 1) << third->stderr_text();
   third->signal(SIGTERM);
   EXPECT_EQ(third->wait_exit(std::chrono::seconds(20)), 0);

@@ -105,14 +105,10 @@ TEST_P(EventsTest, MonitorEventsAreExactlyTheAlarmsMpmdPublishes) {
       << monitor.stdout_text();
 
   // Live: the same samples, sequence number = row index, every one seen.
-  auto t = make_transport();
-  ASSERT_TRUE(t);
-  Observer obs(*t);
-  const std::string config = write_config("mpmd.yaml", "wb",
-                                          std::string("monitor: {forgetting: ") + kForgetting +
-                                              ", settle_samples: " + kSettle + "}\n");
-  auto mpmd = start_mpmd(config);
-  ASSERT_TRUE(obs.wait_status("wb", [](const msg::Status&) { return true; })) << mpmd->stderr_text();
+  const std::string live_monitor =
+      std::string("monitor: {forgetting: ") + kForgetting + ", settle_samples: " + kSettle + "}\n";
+  Session run = open_session(write_config("mpmd.yaml", "wb", live_monitor), "wb", 0);
+  ASSERT_TRUE(run.up) << run.log();
   const PlantModel plant = config::load_plant(plant_file);
   const config::Recording rec = config::load_recording(csv);
   const config::BoundRecording bound = config::bind(plant, rec);
@@ -127,26 +123,28 @@ TEST_P(EventsTest, MonitorEventsAreExactlyTheAlarmsMpmdPublishes) {
     s.seq = k;
     for (std::size_t i = 0; i < 2; ++i) s.u[i] = rec.data(k, static_cast<Eigen::Index>(bound.inputs[i]));
     for (std::size_t j = 0; j < 2; ++j) s.y[j] = rec.data(k, static_cast<Eigen::Index>(bound.outputs[j]));
-    ASSERT_TRUE(t->publish(s));
+    ASSERT_TRUE(run.t->publish(s));
     ++sent;
     if (sent % 50 == 0 || sent == kSamples) {
-      ASSERT_TRUE(obs.wait_status("wb", [sent](const msg::Status& st) { return st.samples_seen >= sent; }))
-          << "sample " << k << ": " << mpmd->stderr_text();
+      ASSERT_TRUE(run.obs->wait_status("wb", [sent](const msg::Status& st) { return st.samples_seen >= sent; }))
+          << "sample " << k << ": " << run.mpmd->stderr_text();
     }
   }
-  const msg::Status status = *obs.status("wb");
+  const msg::Status status = *run.obs->status("wb");
   EXPECT_EQ(status.samples_seen, kSamples);
   EXPECT_EQ(status.gaps + status.duplicates + status.out_of_order + status.malformed + status.dropped, 0);
   // An alarm goes out before the status that counts its sample; two more
   // status periods let any late one arrive before the count is compared.
-  ASSERT_TRUE(obs.wait_alarms([&](const auto& a) { return a.size() >= events.size(); }, std::chrono::seconds(20)));
-  const int statuses = obs.status_count("wb");
-  ASSERT_TRUE(eventually([&] { return obs.status_count("wb") >= statuses + 2; }, std::chrono::seconds(10)));
+  ASSERT_TRUE(run.obs->wait_alarms([&](const auto& a) { return a.size() >= events.size(); }, std::chrono::seconds(20)));
+  const int statuses = run.obs->status_count("wb");
+  ASSERT_TRUE(eventually([&] { return run.obs->status_count("wb") >= statuses + 2; }, std::chrono::seconds(10)));
 
-  ASSERT_EQ(obs.alarms().size(), events.size()) << monitor.stdout_text();
+  ASSERT_EQ(run.obs->alarms().size(), events.size()) << monitor.stdout_text();
   // The scan's events, as a set keyed by (sample, output, raised).
   std::vector<msg::Alarm> alarms, scan_alarms;
-  for (const msg::Alarm& a : obs.alarms()) (a.text.rfind("diagnosis scan:", 0) == 0 ? scan_alarms : alarms).push_back(a);
+  for (const msg::Alarm& a : run.obs->alarms()) {
+    (a.text.rfind("diagnosis scan:", 0) == 0 ? scan_alarms : alarms).push_back(a);
+  }
   std::map<std::tuple<std::int64_t, std::string, bool>, Event> scan_events;
   std::vector<Event> sequential;
   for (const Event& e : events) {
@@ -186,8 +184,8 @@ TEST_P(EventsTest, MonitorEventsAreExactlyTheAlarmsMpmdPublishes) {
   }
   std::printf("%zu events, the first: %s\n", events.size(), alarms.front().text.c_str());
 
-  mpmd->signal(SIGTERM);
-  EXPECT_EQ(mpmd->wait_exit(std::chrono::seconds(20)), 0);
+  run.mpmd->signal(SIGTERM);
+  EXPECT_EQ(run.mpmd->wait_exit(std::chrono::seconds(20)), 0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Transports, EventsTest, ::testing::Values(transport::Kind::kLcm, transport::Kind::kDds),

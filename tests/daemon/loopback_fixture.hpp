@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <memory>
 #include <ostream>
 #include <string>
@@ -27,6 +28,8 @@ namespace mpm::test {
 inline const std::string kMpmd = MPM_BINARY_DIR "/daemon/mpmd/mpmd";
 inline const std::string kMpm = MPM_BINARY_DIR "/daemon/mpm";
 inline const std::string kLoopbackXml = MPM_SOURCE_DIR "/deploy/dds/cyclonedds-loopback.xml";
+// How long a daemon may take to say its first status (and DDS to match readers).
+inline constexpr std::chrono::seconds kStartTimeout{30};
 
 // One publishing controller: the Wood-Berry stream with sequence numbers.
 struct Controller {
@@ -94,6 +97,35 @@ class LoopbackTest : public ::testing::TestWithParam<transport::Kind> {
     auto t = transport::create(settings_, error);
     EXPECT_TRUE(t) << error;
     return t;
+  }
+
+  // One test's bus and daemon: the test's own transport, an observer on it,
+  // and mpmd (its output files named by `tag`) watching `controller` from
+  // `config`. `up` once the daemon's first status arrived and (DDS) `readers`
+  // sample readers matched ours.
+  struct Session {
+    std::string config;
+    std::unique_ptr<transport::Transport> t;
+    std::unique_ptr<Observer> obs;
+    std::unique_ptr<ChildProcess> mpmd;
+    bool up = false;
+    std::string log() const { return mpmd ? mpmd->stderr_text() : "no transport"; }
+  };
+  Session open_session(const std::string& config, const std::string& controller, int readers,
+                       const std::string& tag = "mpmd") const {
+    Session s;
+    s.config = config;
+    s.t = make_transport();
+    if (!s.t) return s;
+    s.obs = std::make_unique<Observer>(*s.t);
+    s.mpmd = start_mpmd(s.config, tag);
+    s.up = s.obs->wait_status(controller, [](const msg::Status&) { return true; }, kStartTimeout) &&
+           s.t->wait_for_sample_readers(readers, kStartTimeout);
+    return s;
+  }
+  // The same with `mpmd.yaml` of write_config.
+  Session start_session(const std::string& controller, int readers = 1) const {
+    return open_session(write_config("mpmd.yaml", controller), controller, readers);
   }
 
   // Publishes `n` samples, `chunk` at a time, after each chunk waiting until

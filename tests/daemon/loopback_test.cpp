@@ -14,55 +14,33 @@
 namespace mpm::test {
 namespace {
 
-constexpr std::chrono::seconds kStartTimeout{30};
-
-// Starts mpmd for `controller`, waits until its first status arrives and (DDS)
-// its sample reader has matched ours.
-struct Running {
-  std::unique_ptr<ChildProcess> mpmd;
-  bool up = false;
-};
-
-Running start_and_wait(const LoopbackTest& test, const std::function<std::unique_ptr<ChildProcess>()>& start,
-                       transport::Transport& t, Observer& obs, const std::string& controller, int readers = 1) {
-  Running r{start(), false};
-  r.up = obs.wait_status(controller, [](const msg::Status&) { return true; }, kStartTimeout) &&
-         t.wait_for_sample_readers(readers, kStartTimeout);
-  (void)test;
-  return r;
-}
-
 bool alarm_is(const msg::Alarm& a, const std::string& controller, const char* output, const char* input,
               bool raised) {
   return a.controller_id == controller && a.output == output && a.input == input && a.raised == raised;
 }
 
 TEST_P(LoopbackTest, MismatchRaisesOnlyU1ToY2AndClearsWhenThePlantReturns) {
-  auto t = make_transport();
-  ASSERT_TRUE(t);
-  Observer obs(*t);
-  const std::string config = write_config("mpmd.yaml", "wb");
-  auto run = start_and_wait(*this, [&] { return start_mpmd(config); }, *t, obs, "wb");
-  ASSERT_TRUE(run.up) << run.mpmd->stderr_text();
+  Session run = start_session("wb");
+  ASSERT_TRUE(run.up) << run.log();
   Controller c("wb", 11);
 
   // Matched plant: status flows, the monitor gets ready, nothing is raised.
-  ASSERT_TRUE(publish_synced(*t, obs, c, 1000)) << run.mpmd->stderr_text();
-  ASSERT_TRUE(obs.wait_status("wb", [](const msg::Status& s) { return s.ready; }));
-  EXPECT_TRUE(obs.alarms().empty());
+  ASSERT_TRUE(publish_synced(*run.t, *run.obs, c, 1000)) << run.mpmd->stderr_text();
+  ASSERT_TRUE(run.obs->wait_status("wb", [](const msg::Status& s) { return s.ready; }));
+  EXPECT_TRUE(run.obs->alarms().empty());
 
   // G21 x 1.2: the alarm of u1 -> y2 within a bounded number of samples.
   c.stream.set_g21_gain(1.2);
   const std::int64_t onset = c.seq;
-  for (int k = 0; k < 20 && obs.alarms().empty(); ++k) ASSERT_TRUE(publish_synced(*t, obs, c, 50));
-  ASSERT_TRUE(obs.wait_alarms([](const auto& a) { return !a.empty(); }, std::chrono::seconds(10)));
-  const msg::Alarm raised = obs.alarms().front();
+  for (int k = 0; k < 20 && run.obs->alarms().empty(); ++k) ASSERT_TRUE(publish_synced(*run.t, *run.obs, c, 50));
+  ASSERT_TRUE(run.obs->wait_alarms([](const auto& a) { return !a.empty(); }, std::chrono::seconds(10)));
+  const msg::Alarm raised = run.obs->alarms().front();
   EXPECT_TRUE(alarm_is(raised, "wb", "y2", "u1", true)) << raised.text;
   EXPECT_LT(raised.sample_sequence - onset, 600);
   // The focused score raises early, on less evidence in the full space: the
   // channel's conditional score names it on its own below `false_alarm`.
   EXPECT_LT(raised.p_value, 1e-3);
-  EXPECT_TRUE(obs.wait_status("wb", [](const msg::Status& s) { return s.alarms_raised == 1; }));
+  EXPECT_TRUE(run.obs->wait_status("wb", [](const msg::Status& s) { return s.alarms_raised == 1; }));
 
   if (GetParam() == transport::Kind::kDds) {
     // DDS alarms are transient-local: an operator who starts listening now
@@ -77,12 +55,12 @@ TEST_P(LoopbackTest, MismatchRaisesOnlyU1ToY2AndClearsWhenThePlantReturns) {
 
   // Back to the matched plant: it clears; no other channel was ever raised.
   c.stream.set_g21_gain(1.0);
-  for (int k = 0; k < 40 && obs.alarms().size() < 2; ++k) ASSERT_TRUE(publish_synced(*t, obs, c, 50));
-  ASSERT_TRUE(obs.wait_alarms([](const auto& a) { return a.size() >= 2; }, std::chrono::seconds(10)));
-  const auto alarms = obs.alarms();
+  for (int k = 0; k < 40 && run.obs->alarms().size() < 2; ++k) ASSERT_TRUE(publish_synced(*run.t, *run.obs, c, 50));
+  ASSERT_TRUE(run.obs->wait_alarms([](const auto& a) { return a.size() >= 2; }, std::chrono::seconds(10)));
+  const auto alarms = run.obs->alarms();
   ASSERT_EQ(alarms.size(), 2u);
   EXPECT_TRUE(alarm_is(alarms[1], "wb", "y2", "u1", false)) << alarms[1].text;
-  EXPECT_TRUE(obs.wait_status("wb", [](const msg::Status& s) { return s.alarms_raised == 0; }));
+  EXPECT_TRUE(run.obs->wait_status("wb", [](const msg::Status& s) { return s.alarms_raised == 0; }));
 
   run.mpmd->signal(SIGTERM);
   EXPECT_EQ(run.mpmd->wait_exit(std::chrono::seconds(20)), 0);
@@ -90,40 +68,37 @@ TEST_P(LoopbackTest, MismatchRaisesOnlyU1ToY2AndClearsWhenThePlantReturns) {
 }
 
 TEST_P(LoopbackTest, BadSamplesAreCountedLoggedOnceAndSurvived) {
-  auto t = make_transport();
-  ASSERT_TRUE(t);
-  Observer obs(*t);
-  auto run = start_and_wait(*this, [&] { return start_mpmd(write_config("mpmd.yaml", "wb")); }, *t, obs, "wb");
-  ASSERT_TRUE(run.up) << run.mpmd->stderr_text();
+  Session run = start_session("wb");
+  ASSERT_TRUE(run.up) << run.log();
   Controller c("wb", 12);
-  ASSERT_TRUE(publish_synced(*t, obs, c, 600));
-  ASSERT_TRUE(obs.wait_status("wb", [](const msg::Status& s) { return s.ready; }));
-  const msg::Status before = *obs.status("wb");
+  ASSERT_TRUE(publish_synced(*run.t, *run.obs, c, 600));
+  ASSERT_TRUE(run.obs->wait_status("wb", [](const msg::Status& s) { return s.ready; }));
+  const msg::Status before = *run.obs->status("wb");
 
   for (int k = 0; k < 3; ++k) {  // wrong-sized: three inputs
     msg::Sample s = c.next();
     s.u.push_back(0.0);
     // Refused by the transport's decoder against the plant's dimensions, so
     // counted as malformed but never seen by the service (not in c.sent).
-    ASSERT_TRUE(t->publish(s));
+    ASSERT_TRUE(run.t->publish(s));
   }
   c.seq += 5;  // a gap of five
-  ASSERT_TRUE(send(*t, c, c.next()));
-  ASSERT_TRUE(send(*t, c, c.sample));  // duplicated twice
-  ASSERT_TRUE(send(*t, c, c.sample));
+  ASSERT_TRUE(send(*run.t, c, c.next()));
+  ASSERT_TRUE(send(*run.t, c, c.sample));  // duplicated twice
+  ASSERT_TRUE(send(*run.t, c, c.sample));
   const msg::Sample skipped = c.next();  // out of order
-  ASSERT_TRUE(send(*t, c, c.next()));
-  ASSERT_TRUE(send(*t, c, skipped));
+  ASSERT_TRUE(send(*run.t, c, c.next()));
+  ASSERT_TRUE(send(*run.t, c, skipped));
   for (int k = 0; k < 2; ++k) {  // NaN values
     msg::Sample s = c.next();
     s.y[0] = std::numeric_limits<double>::quiet_NaN();
-    ASSERT_TRUE(send(*t, c, s));
+    ASSERT_TRUE(send(*run.t, c, s));
   }
   c.sample.session_id += 1;  // the publisher restarts: new session, from 1
   c.seq = 0;
-  ASSERT_TRUE(publish_synced(*t, obs, c, 500));
+  ASSERT_TRUE(publish_synced(*run.t, *run.obs, c, 500));
 
-  const msg::Status after = *obs.status("wb");
+  const msg::Status after = *run.obs->status("wb");
   EXPECT_EQ(after.malformed - before.malformed, 3);
   EXPECT_EQ(after.gaps - before.gaps, 2);  // the planted one and the hole of the late sample
   // The planted five, the three refused samples (their numbers never reached
@@ -151,15 +126,11 @@ TEST_P(LoopbackTest, BadSamplesAreCountedLoggedOnceAndSurvived) {
 }
 
 TEST_P(LoopbackTest, SighupWithABrokenConfigKeepsTheRunningOne) {
-  auto t = make_transport();
-  ASSERT_TRUE(t);
-  Observer obs(*t);
-  const std::string config = write_config("mpmd.yaml", "wb");
-  auto run = start_and_wait(*this, [&] { return start_mpmd(config); }, *t, obs, "wb");
-  ASSERT_TRUE(run.up) << run.mpmd->stderr_text();
+  Session run = start_session("wb");
+  ASSERT_TRUE(run.up) << run.log();
   Controller c("wb", 13);
-  ASSERT_TRUE(publish_synced(*t, obs, c, 400));
-  const double threshold = obs.status("wb")->raise_threshold;
+  ASSERT_TRUE(publish_synced(*run.t, *run.obs, c, 400));
+  const double threshold = run.obs->status("wb")->raise_threshold;
 
   // Broken: a monitor setting out of range.
   write_config("mpmd.yaml", "wb", "monitor: {forgetting: 1.5}\n");
@@ -168,22 +139,22 @@ TEST_P(LoopbackTest, SighupWithABrokenConfigKeepsTheRunningOne) {
       << run.mpmd->stderr_text();
   EXPECT_NE(run.mpmd->stderr_text().find("forgetting"), std::string::npos) << "the error names the key";
   EXPECT_TRUE(run.mpmd->running());
-  ASSERT_TRUE(publish_synced(*t, obs, c, 200)) << "still serving";
-  EXPECT_EQ(obs.status("wb")->raise_threshold, threshold) << "still the old settings";
-  EXPECT_GE(obs.status("wb")->samples_seen, 600);
+  ASSERT_TRUE(publish_synced(*run.t, *run.obs, c, 200)) << "still serving";
+  EXPECT_EQ(run.obs->status("wb")->raise_threshold, threshold) << "still the old settings";
+  EXPECT_GE(run.obs->status("wb")->samples_seen, 600);
 
   // Not YAML at all.
   dir().write("mpmd.yaml", "controller_id: [unclosed\n");
   run.mpmd->signal(SIGHUP);
   ASSERT_TRUE(eventually([&] { return count_lines(run.mpmd->stderr_text(), "reload failed") == 2; }));
-  ASSERT_TRUE(publish_synced(*t, obs, c, 100));
+  ASSERT_TRUE(publish_synced(*run.t, *run.obs, c, 100));
 
   // A valid new level is applied.
   write_config("mpmd.yaml", "wb",
                "monitor: {ar_order: 5, input_order: 10, forgetting: 0.995, false_alarm: 1.0e-3,\n"
                "          false_alarms_per_year: 1000, settle_samples: 100}\n");
   run.mpmd->signal(SIGHUP);
-  ASSERT_TRUE(obs.wait_status("wb", [&](const msg::Status& s) { return s.raise_threshold < threshold; }));
+  ASSERT_TRUE(run.obs->wait_status("wb", [&](const msg::Status& s) { return s.raise_threshold < threshold; }));
   EXPECT_EQ(count_lines(run.mpmd->stderr_text(), "reloaded"), 1);
   run.mpmd->signal(SIGTERM);
   EXPECT_EQ(run.mpmd->wait_exit(std::chrono::seconds(20)), 0);
@@ -218,6 +189,13 @@ class NotifySocket {
         },
         timeout);
   }
+  // Collects messages until `needle` has come at least `n` times.
+  bool wait_count(const std::string& needle, int n) {
+    return eventually([&] {
+      wait_for("never", std::chrono::seconds(0));
+      return count(needle) >= n;
+    });
+  }
   int count(const std::string& needle) const {
     int n = 0;
     for (const auto& m : messages) n += m.find(needle) != std::string::npos ? 1 : 0;
@@ -242,16 +220,10 @@ TEST_P(LoopbackTest, TellsSystemdReadyWatchdogReloadingAndStopping) {
   ASSERT_TRUE(notify.wait_for("READY=1")) << mpmd->stderr_text();
   EXPECT_NE(notify.messages.front().find("STATUS=watching controller 'wb'"), std::string::npos);
   ASSERT_TRUE(notify.wait_for("WATCHDOG=1"));
-  ASSERT_TRUE(eventually([&] {
-    notify.wait_for("never", std::chrono::seconds(0));
-    return notify.count("WATCHDOG=1") >= 3;
-  })) << "the watchdog keeps being fed";
+  ASSERT_TRUE(notify.wait_count("WATCHDOG=1", 3)) << "the watchdog keeps being fed";
   mpmd->signal(SIGHUP);
   ASSERT_TRUE(notify.wait_for("RELOADING=1"));
-  ASSERT_TRUE(eventually([&] {
-    notify.wait_for("never", std::chrono::seconds(0));
-    return notify.count("READY=1") >= 2;
-  })) << "READY=1 again after the reload";
+  ASSERT_TRUE(notify.wait_count("READY=1", 2)) << "READY=1 again after the reload";
   mpmd->signal(SIGTERM);
   ASSERT_TRUE(notify.wait_for("STOPPING=1"));
   EXPECT_EQ(mpmd->wait_exit(std::chrono::seconds(20)), 0);
@@ -332,12 +304,8 @@ TEST_P(LoopbackTest, ThreeControllersOneListener) {
 
 // `mpm replay` publishes a recording as the controller would.
 TEST_P(LoopbackTest, ReplayCommandPublishesARecording) {
-  auto t = make_transport();
-  ASSERT_TRUE(t);
-  Observer obs(*t);
-  const std::string config = write_config("mpmd.yaml", "wb");
-  auto run = start_and_wait(*this, [&] { return start_mpmd(config); }, *t, obs, "wb", 0);
-  ASSERT_TRUE(run.up);
+  Session run = start_session("wb", 0);
+  ASSERT_TRUE(run.up) << run.log();
   // A recording in the CSV layout of formats.md, with a setpoint and an extra signal.
   {
     std::ofstream csv(dir().file("run.csv"));
@@ -349,13 +317,13 @@ TEST_P(LoopbackTest, ReplayCommandPublishesARecording) {
       csv << k << ',' << u[0] << ',' << u[1] << ',' << y[0] << ',' << y[1] << ",90,1.5\n";
     }
   }
-  ChildProcess replay({kMpm, "replay", "--config", config, "--data", dir().file("run.csv"), "--rate", "2000"},
+  ChildProcess replay({kMpm, "replay", "--config", run.config, "--data", dir().file("run.csv"), "--rate", "2000"},
                       dir().file("replay.out"), dir().file("replay.err"));
   ASSERT_EQ(replay.wait_exit(std::chrono::seconds(40)), 0) << replay.stderr_text();
   EXPECT_NE(replay.stdout_text().find("published 500 samples"), std::string::npos) << replay.stdout_text();
-  ASSERT_TRUE(obs.wait_status("wb", [](const msg::Status& s) { return s.samples_seen == 500; }))
-      << obs.status("wb")->samples_seen;
-  const msg::Status s = *obs.status("wb");
+  ASSERT_TRUE(run.obs->wait_status("wb", [](const msg::Status& s) { return s.samples_seen == 500; }))
+      << run.obs->status("wb")->samples_seen;
+  const msg::Status s = *run.obs->status("wb");
   EXPECT_EQ(s.malformed, 0);
   EXPECT_EQ(s.restarts, 0);
   EXPECT_GT(s.samples_used, 200);  // all but the settle time and regressor fill
@@ -366,22 +334,18 @@ TEST_P(LoopbackTest, ReplayCommandPublishesARecording) {
 class SimulateLiveTest : public LoopbackTest {
  protected:
   void expect_simulate_live_drives_mpmd(const std::vector<std::string>& scenario_args) {
-    auto t = make_transport();
-    ASSERT_TRUE(t);
-    Observer obs(*t);
-    const std::string config = write_config("mpmd.yaml", "wood-berry");
-    auto run = start_and_wait(*this, [&] { return start_mpmd(config); }, *t, obs, "wood-berry", 0);
-    ASSERT_TRUE(run.up);
+    Session run = start_session("wood-berry", 0);
+    ASSERT_TRUE(run.up) << run.log();
     std::vector<std::string> args{kMpm, "simulate-live"};
     args.insert(args.end(), scenario_args.begin(), scenario_args.end());
-    args.insert(args.end(), {"--config", config, "--samples", "300", "--rate", "2000"});
+    args.insert(args.end(), {"--config", run.config, "--samples", "300", "--rate", "2000"});
     ChildProcess live(args, dir().file("live.out"), dir().file("live.err"));
     ASSERT_EQ(live.wait_exit(std::chrono::seconds(40)), 0) << live.stderr_text();
     EXPECT_NE(live.stdout_text().find("published 300 samples of " + scenario_args[1]), std::string::npos)
         << live.stdout_text();
-    ASSERT_TRUE(obs.wait_status("wood-berry", [](const msg::Status& s) { return s.samples_seen == 300; }))
-        << obs.status("wood-berry")->samples_seen;
-    const msg::Status s = *obs.status("wood-berry");
+    ASSERT_TRUE(run.obs->wait_status("wood-berry", [](const msg::Status& s) { return s.samples_seen == 300; }))
+        << run.obs->status("wood-berry")->samples_seen;
+    const msg::Status s = *run.obs->status("wood-berry");
     EXPECT_EQ(s.malformed, 0);
     EXPECT_EQ(s.gaps, 0);
     EXPECT_EQ(s.nan_samples, 0);

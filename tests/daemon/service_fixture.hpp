@@ -9,6 +9,7 @@
 #include "config/plant_loader.hpp"
 #include "daemon/mpmd/log.hpp"
 #include "daemon/mpmd/monitor_service.hpp"
+#include "daemon/mpmd/setup.hpp"
 
 namespace mpm::test {
 
@@ -33,6 +34,19 @@ inline ServiceSettings fast_service(const std::string& controller = "wb") {
   s.log_interval = 3600;  // "logged once" within a test
   s.diagnosis_window = 0;  // no diagnosis thread unless a test asks for one
   return s;
+}
+
+// What mpmd would load for controller "wb" on the Wood-Berry plant, with the
+// fast settings and a status every `status_period` seconds.
+inline LoadedConfig wood_berry_config(double status_period) {
+  LoadedConfig loaded;
+  loaded.config.controller_id = "wb";
+  loaded.config.status_period = status_period;
+  loaded.config.monitor = fast_settings();
+  loaded.config.settle_samples = 100;
+  loaded.config.log_interval = 3600;  // "logged once" within a test
+  loaded.plant = wood_berry_plant();
+  return loaded;
 }
 
 // Collects log lines while alive (the service logs through mpm::log).

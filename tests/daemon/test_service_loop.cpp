@@ -42,12 +42,7 @@ TEST(SampleQueue, RefusesWhenFullAndKeepsOrder) {
 struct FakeDaemon {
   explicit FakeDaemon(std::shared_ptr<transport::FakeBus> bus, std::size_t queue_capacity)
       : transport(transport::make_fake_transport(bus)), queue(queue_capacity), receiver(*transport, queue) {
-    loaded.config.controller_id = "wb";
-    loaded.config.status_period = 0.05;
-    loaded.config.monitor = test::fast_settings();
-    loaded.config.settle_samples = 100;
-    loaded.config.log_interval = 3600;
-    loaded.plant = test::wood_berry_plant();
+    loaded = test::wood_berry_config(0.05);
     std::string error;
     service = make_service(loaded, publish_to(transport), error);
     EXPECT_TRUE(service) << error;

@@ -290,13 +290,7 @@ TEST(ServiceLoopReload, ASighupStormIsLoggedAtALimitedRate) {
   SampleQueue queue(16);
   Receiver receiver(*transport, queue);
   Notifier notifier;
-  LoadedConfig loaded;
-  loaded.config.controller_id = "wb";
-  loaded.config.status_period = 3600;
-  loaded.config.monitor = test::fast_settings();
-  loaded.config.settle_samples = 100;
-  loaded.config.log_interval = 3600;
-  loaded.plant = test::wood_berry_plant();
+  LoadedConfig loaded = test::wood_berry_config(3600);
   std::string error;
   auto service = make_service(loaded, nullptr, error);
   ASSERT_TRUE(service) << error;

@@ -79,6 +79,40 @@ bool viewer_open(const std::string& out, const std::string& channel) {
   return false;
 }
 
+// lcm-spy's row of `channel` once the probe reports it.
+std::optional<Row> wait_row(const ChildProcess& spy, const std::string& channel) {
+  if (!eventually([&] { return row(spy.stdout_text(), channel).has_value(); })) return std::nullopt;
+  return row(spy.stdout_text(), channel);
+}
+
+// Decoded by lcm-spy as our `type`, nothing undecodable.
+void expect_decoded(const Row& r, const std::string& type) {
+  EXPECT_EQ(r.type, type) << r.channel;
+  EXPECT_EQ(r.undecodable, 0) << r.channel;
+}
+
+// Double-clicks `r` in lcm-spy's channel table (on `display`) until its viewer opens.
+bool open_viewer(const std::string& display, const ChildProcess& spy, const Row& r) {
+  const std::string click = "DISPLAY=" + display + " xdotool mousemove " + std::to_string(r.x) + " " +
+                            std::to_string(r.y) + " click --repeat 2 --delay 100 1";
+  return eventually([&] {
+    if (std::system(click.c_str()) != 0) return false;
+    return eventually([&] { return viewer_open(spy.stdout_text(), r.channel); }, std::chrono::seconds(3));
+  });
+}
+
+// A picture of the whole screen in `path`. The viewer paints its fields after
+// opening; the probe saw its panel, the picture is kept once it has been on
+// screen for a report or two.
+bool screenshot(const std::string& display, const std::string& path) {
+  std::filesystem::create_directories(MPM_BINARY_DIR "/Testing");
+  std::filesystem::remove(path);
+  return eventually([&] {
+    return std::system(("DISPLAY=" + display + " import -window root " + path).c_str()) == 0 &&
+           std::filesystem::file_size(path) > 10000;
+  });
+}
+
 TEST(LcmSpy, ShowsOurAlarmsDecoded) {
   for (const char* tool : {"Xvfb", "xdotool", "import", "java"}) {
     ASSERT_TRUE(on_path(tool)) << tool << " is missing: apt-get install -y xvfb xdotool imagemagick "
@@ -138,58 +172,29 @@ TEST(LcmSpy, ShowsOurAlarmsDecoded) {
   ASSERT_TRUE(obs.wait_alarms([](const auto& a) { return !a.empty(); }, std::chrono::seconds(10)));
 
   // lcm-spy decoded it: our type name, nothing undecodable.
-  ASSERT_TRUE(eventually([&] { return row(spy.stdout_text(), "MPM_ALARM").has_value(); }))
-      << spy.stdout_text();
-  const Row alarm = *row(spy.stdout_text(), "MPM_ALARM");
-  EXPECT_EQ(alarm.type, "alarm_t");
-  EXPECT_GE(alarm.messages, 1);
-  EXPECT_EQ(alarm.undecodable, 0);
-  const Row status = *row(spy.stdout_text(), "MPM_STATUS");
-  EXPECT_EQ(status.type, "status_t");
-  EXPECT_EQ(status.undecodable, 0);
-  const Row sample = *row(spy.stdout_text(), "MPM_SAMPLE");
-  EXPECT_EQ(sample.type, "sample_t");
-  EXPECT_EQ(sample.undecodable, 0);
+  const std::optional<Row> alarm = wait_row(spy, "MPM_ALARM");
+  ASSERT_TRUE(alarm) << spy.stdout_text();
+  expect_decoded(*alarm, "alarm_t");
+  EXPECT_GE(alarm->messages, 1);
+  expect_decoded(*row(spy.stdout_text(), "MPM_STATUS"), "status_t");
+  expect_decoded(*row(spy.stdout_text(), "MPM_SAMPLE"), "sample_t");
 
   // Open the alarm's viewer as an operator would, and keep a picture of it.
-  const std::string click = "DISPLAY=" + display + " xdotool mousemove " + std::to_string(alarm.x) + " " +
-                            std::to_string(alarm.y) + " click --repeat 2 --delay 100 1";
-  ASSERT_TRUE(eventually([&] {
-    if (std::system(click.c_str()) != 0) return false;
-    return eventually([&] { return viewer_open(spy.stdout_text(), "MPM_ALARM"); }, std::chrono::seconds(3));
-  })) << spy.stdout_text();
-  std::filesystem::create_directories(MPM_BINARY_DIR "/Testing");
-  std::filesystem::remove(kScreenshot);
-  // The viewer paints its fields after opening; the probe saw its panel, take
-  // the picture once it has been on screen for a report or two.
-  ASSERT_TRUE(eventually([&] {
-    return std::system(("DISPLAY=" + display + " import -window root " + kScreenshot).c_str()) == 0 &&
-           std::filesystem::file_size(kScreenshot) > 10000;
-  }));
+  ASSERT_TRUE(open_viewer(display, spy, *alarm)) << spy.stdout_text();
+  ASSERT_TRUE(screenshot(display, kScreenshot));
   std::printf("screenshot: %s\n", kScreenshot.c_str());
 
   // The diagnosis that follows the raise: decoded as diagnosis_t.
   ASSERT_TRUE(eventually([&] { return !obs.diagnoses().empty(); })) << mpmd.stderr_text();
-  ASSERT_TRUE(eventually([&] { return row(spy.stdout_text(), "MPM_DIAGNOSIS").has_value(); }))
-      << spy.stdout_text();
-  const Row diagnosis = *row(spy.stdout_text(), "MPM_DIAGNOSIS");
-  EXPECT_EQ(diagnosis.type, "diagnosis_t");
-  EXPECT_GE(diagnosis.messages, 1);
-  EXPECT_EQ(diagnosis.undecodable, 0);
+  const std::optional<Row> diagnosis = wait_row(spy, "MPM_DIAGNOSIS");
+  ASSERT_TRUE(diagnosis) << spy.stdout_text();
+  expect_decoded(*diagnosis, "diagnosis_t");
+  EXPECT_GE(diagnosis->messages, 1);
   // The alarm's viewer opened over the channel table (no window manager
   // here): hide it so the double-click reaches the table.
   std::system(("DISPLAY=" + display + " xdotool search --name '^MPM_ALARM$' windowunmap >/dev/null 2>&1").c_str());
-  const std::string open_diagnosis = "DISPLAY=" + display + " xdotool mousemove " + std::to_string(diagnosis.x) +
-                                     " " + std::to_string(diagnosis.y) + " click --repeat 2 --delay 100 1";
-  ASSERT_TRUE(eventually([&] {
-    if (std::system(open_diagnosis.c_str()) != 0) return false;
-    return eventually([&] { return viewer_open(spy.stdout_text(), "MPM_DIAGNOSIS"); }, std::chrono::seconds(3));
-  })) << spy.stdout_text();
-  std::filesystem::remove(kDiagnosisScreenshot);
-  ASSERT_TRUE(eventually([&] {
-    return std::system(("DISPLAY=" + display + " import -window root " + kDiagnosisScreenshot).c_str()) == 0 &&
-           std::filesystem::file_size(kDiagnosisScreenshot) > 10000;
-  }));
+  ASSERT_TRUE(open_viewer(display, spy, *diagnosis)) << spy.stdout_text();
+  ASSERT_TRUE(screenshot(display, kDiagnosisScreenshot));
   std::printf("screenshot: %s (%s)\n", kDiagnosisScreenshot.c_str(), obs.diagnoses().front().text.c_str());
 
   spy.signal(SIGTERM);

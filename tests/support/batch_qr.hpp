@@ -58,6 +58,21 @@ struct DataGen {
   }
 };
 
+// Feeds `rows.rows()` samples of `gen` to `rls` and keeps them as the rows
+// [x' y] of `rows`, so that a batch fit sees exactly the data the recursion saw.
+template <typename Rls>
+void feed(Rls& rls, DataGen& gen, Eigen::MatrixXd& rows) {
+  const Eigen::Index p = rows.cols() - 1;
+  Eigen::VectorXd x(p);
+  double y = 0;
+  for (Eigen::Index k = 0; k < rows.rows(); ++k) {
+    gen.next(x, y);
+    rls.update(x.data(), y);
+    rows.row(k).head(p) = x.transpose();
+    rows(k, p) = y;
+  }
+}
+
 inline std::vector<int> range_except(int p, int first, int count) {
   std::vector<int> v;
   for (int i = 0; i < p; ++i)
