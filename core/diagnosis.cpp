@@ -1,8 +1,10 @@
 // Selection of the diagnosis: rounds of generating every hypothesis of the
 // table that applies (diagnosis_table.cpp), on Settings::threads threads,
 // then taking the best candidate that passes (greedy), subtracting its
-// correction and refitting. Afterwards the disturbance-model rows on the
-// outputs no finding explains, and the monitor's fallback (`other`).
+// correction (or, for a changed disturbance model, changing the output's
+// whitener) and refitting. Afterwards the disturbance-model rows on the
+// outputs no finding explains, at their own level, and the monitor's
+// fallback (`other`).
 #include "core/diagnosis.hpp"
 
 #include <algorithm>
@@ -88,8 +90,8 @@ Candidate rebuild_chosen(Context& cx, const Groups& groups, const Candidate& cho
 }
 
 std::vector<Candidate> generate(const Context& cx, const std::set<std::pair<std::size_t, long>>& used,
-                                const std::set<std::pair<std::size_t, std::size_t>>& used_signals, Groups& groups,
-                                Progress progress) {
+                                const std::set<std::pair<std::size_t, std::size_t>>& used_signals,
+                                const std::vector<bool>& noise_changed, Groups& groups, Progress progress) {
   std::vector<Candidate> all;
   const auto add = [&](Scope scope, Site site) {
     groups.add([&cx, scope, site](std::vector<Candidate>& o) { run_scope(cx, scope, site, o); });
@@ -119,6 +121,11 @@ std::vector<Candidate> generate(const Context& cx, const std::set<std::pair<std:
       if (lr > pre) add(Scope::signal, {.output = j, .column = column});
     }
   groups.flush(all, cx.settings.threads);
+  // A changed disturbance model of each output, once per output: the
+  // process changes above compete with it for the same residual.
+  for (std::size_t j = 0; j < cx.n_out(); ++j)
+    if (!noise_changed[j]) add(Scope::noise, {.output = j});
+  groups.flush(all, cx.settings.threads);
   std::vector<Candidate> keep;
   for (auto& c : all)
     if (!overlaps(used, c.finding)) keep.push_back(std::move(c));
@@ -133,13 +140,21 @@ std::string describe(const Context& cx, const Candidate& c, double family, doubl
     m += p.outputs[ch.output] + "<-" + (ch.input ? p.inputs[*ch.input] : c.finding.signal.value_or("-")) + " ";
   return m + "] lr " + fmt(c.lr, 4) + " (limit " +
          fmt(chi_square_quantile_upper(fit_level(cx.settings, family), c.params), 3) + ") z_hold " + fmt(c.z_hold, 3) +
-         " bic " + fmt(c.bic(log_n), 4) + " selection " + fmt(selection_score(cx, c, log_n), 4) + ": " +
+         " beyond_noise " + fmt(c.lr_beyond_noise, 4) + " bic " + fmt(c.bic(log_n), 4) + " selection " + fmt(selection_score(cx, c, log_n), 4) + ": " +
          c.finding.summary;
 }
 
 // Takes the chosen candidate's correction out of its outputs' residuals: a
-// recorded signal instead joins the output's free signal regressors.
+// recorded signal instead joins the output's free signal regressors, and a
+// changed disturbance model becomes part of its output's whitener (later
+// candidates on that output are fitted and tested under the new noise model).
 void accept(Context& cx, const Candidate& chosen) {
+  if (chosen.whitener_change) {
+    OutputState& o = cx.out[chosen.fits.at(0).output];
+    o.whitener = series(*chosen.whitener_change, o.whitener);
+    refresh(cx, chosen.fits[0].output);
+    return;
+  }
   for (const auto& of : chosen.fits) {
     OutputState& o = cx.out[of.output];
     Vec own = of.correction;
@@ -226,12 +241,13 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
   std::set<std::pair<std::size_t, long>> used;
   std::set<std::pair<std::size_t, std::size_t>> used_signals;
   std::vector<bool> explained(cx.n_out(), false);
+  std::vector<bool> noise_changed(cx.n_out(), false);
   double family = 0.0;
   const double log_n = std::log(static_cast<double>(cx.seg.fit_samples()));
   for (int round = 0; round < settings.max_findings; ++round) {
     Groups groups;
     cx.keep_series = false;
-    std::vector<Candidate> cands = generate(cx, used, used_signals, groups, progress);
+    std::vector<Candidate> cands = generate(cx, used, used_signals, noise_changed, groups, progress);
     cx.keep_series = true;
     if (round == 0) family = std::max<double>(1.0, static_cast<double>(cands.size()));
     // A recorded signal that explains the residual goes first: while it is
@@ -261,6 +277,7 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
       if (ch.input) used.insert({ch.output, static_cast<long>(*ch.input)});
       explained[ch.output] = true;
     }
+    if (chosen.whitener_change) noise_changed[f.channels.at(0).output] = true;
     if (f.signal)
       for (std::size_t c = 0; c < problem.extra_names.size(); ++c)
         if (problem.extra_names[c] == *f.signal) used_signals.insert({f.channels[0].output, c});
@@ -268,7 +285,9 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
     r.findings.push_back(std::move(f));
     if (progress) progress(("accepted: " + r.findings.back().summary).c_str());
   }
-  // A changed disturbance model, where no finding explains the output.
+  // A changed disturbance model, where no finding explains the output: in
+  // the rounds it had to pass the round's family-wise level, here only its
+  // own (its forms over the outputs).
   for (std::size_t j = 0; j < cx.n_out(); ++j) {
     if (explained[j]) continue;
     std::vector<Candidate> noise;

@@ -67,6 +67,11 @@ struct Settings {
   double alpha = 1e-3;          // family-wise false-alarm level of accepting a hypothesis
   double holdout_level = 0.05;  // level of the held-out confirmation (holdout_z is its quantile)
   double holdout_z = 1.645;     // one-sided 5 % paired test on the held-out part
+  // Level of the test that a process candidate explains the residual beyond
+  // a changed disturbance model (the gate of score()): it chooses between two
+  // explanations of a mismatch the family-wise test has already found, so it
+  // is not divided over the family.
+  double beyond_noise_level = 0.01;
   int ar_order = 10;            // AR whitener order when N is unknown
   int input_lags = 10;          // input lags in the ARX noise estimate / Granger tests
   int max_findings = 8;

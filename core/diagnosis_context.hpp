@@ -98,6 +98,10 @@ struct Candidate {
   // The hypothesis fitted jointly with an AR(3) change of the disturbance
   // model, against that change alone: what it explains beyond a wrong N.
   double lr_beyond_noise = 0.0;
+  // A changed disturbance model (the noise row): the filter C that whitens
+  // the output's residual further, the new model being N / C. Accepting the
+  // candidate changes the output's whitener, not its residual.
+  std::optional<DiscreteTf> whitener_change;
   // Where the candidate came from: the `rank`-th candidate of generator call
   // `group` (see rebuild_chosen), for a candidate whose columns were released.
   std::size_t group = 0;

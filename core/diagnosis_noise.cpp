@@ -59,6 +59,7 @@ void fit_disturbance_model(const Context& cx, const Hypothesis& h, const Site& s
   best->finding.parameters["variance"] = best->fits[0].fit.fit_var;
   best->facts["variance_before"] = o.fit_var;
   best->facts["arma"] = best_correction.den.size() > 1 ? 1.0 : 0.0;
+  best->whitener_change = best_correction;
   out.push_back(std::move(*best));
 }
 

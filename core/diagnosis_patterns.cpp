@@ -247,7 +247,9 @@ void fit_sensor(const Context& cx, const Hypothesis& h, const Site& s, std::vect
   // prediction alone would leave the disturbances' part unexplained, and
   // could not tell a sensor from a channel's own lag when one input drives
   // the output; this form does: on a residual without a sensor lag it
-  // colours the noise and loses likelihood.
+  // colours the noise and loses likelihood. The same lag on the
+  // disturbances alone is a changed disturbance model, the noise row's
+  // candidate, which competes with this one in the selection.
   const OutputState& o = cx.out[j];
   const Vec& r = o.signals.empty() ? o.d : o.base;
   const Index n = r.size();
@@ -258,19 +260,6 @@ void fit_sensor(const Context& cx, const Hypothesis& h, const Site& s, std::vect
   };
   const std::vector<double> grid = lag_pole_grid(0.3, 30.0, 16);
   const double a = minimise_on_grid(grid, [&](double v) { return objective(cx, fits(v)); });
-  // The same lag on the disturbances alone (a changed noise model, c = a r(k-1))
-  // must explain clearly less: what makes it a sensor is that the model's
-  // prediction is lagged too. Otherwise it is left to the disturbance-model
-  // step.
-  const auto noise_only = [&](double v) {
-    Vec c = Vec::Zero(n);
-    for (Index k = 1; k < n; ++k) c[k] = v * r[k - 1];
-    return std::vector<OutputFit>{fit_output(cx, j, c, {})};
-  };
-  const double a_noise = minimise_on_grid(grid, [&](double v) { return objective(cx, noise_only(v)); });
-  const double lr_sensor = -objective(cx, fits(a));
-  const double lr_noise = -objective(cx, noise_only(a_noise));
-  if (lr_sensor - lr_noise < chi_square_quantile_upper(cx.settings.alpha, 1.0)) return;
   Candidate c = make_candidate(cx, h, cs, fits(a));
   c.finding.nominal = *cx.channel(j, cs[0].input.value());
   c.finding.fitted = series(*cx.channel(j, cs[0].input.value()), unit_lag(a));

@@ -181,12 +181,13 @@ void score(const Context& cx, Candidate& c) {
 // (held-out level): the fit level is alpha / hold level, shared over the family.
 double fit_level(const Settings& s, double family) { return s.alpha / s.holdout_level / family; }
 
-// The row's gate: a recorded signal is not moved by the controller, so it is
-// not held to the test against a changed disturbance model (see score()).
+// The row's gate (see score() for the test against a changed disturbance
+// model, and the table's rows for who is held to it).
 bool passes(const Candidate& c, const Settings& s, double family) {
   return c.lr >= chi_square_quantile_upper(fit_level(s, family), c.params) && c.z_hold >= s.holdout_z &&
          c.hold_gain > 0.0 &&
-         (c.hypothesis->gate != Gate::beyond_noise || c.lr_beyond_noise >= chi_square_quantile_upper(s.alpha, c.params));
+         (c.hypothesis->gate != Gate::beyond_noise ||
+          c.lr_beyond_noise >= chi_square_quantile_upper(s.beyond_noise_level, c.params));
 }
 
 // Which of the candidates that pass is taken: BIC on the fit part plus the

@@ -26,6 +26,9 @@ bool any_column(const Context& cx, const Site& s) { return cx.excited[s.input] &
 bool shared_column(const Context& cx, const Site& s) { return cx.excited[s.input] && column_outputs(cx, s.input).size() >= 2; }
 // With one input, a row form is that channel's own.
 bool shared_row(const Context& cx, const Site& s) { return row_prediction(cx, s.output).channels.size() >= 2; }
+// A transmitter lag lags the disturbances too, which no channel's own lag
+// does: it is told from one even where a single input drives the output.
+bool modelled_row(const Context& cx, const Site& s) { return !row_prediction(cx, s.output).channels.empty(); }
 // Two or more outputs that several inputs drive (with one, the row form says it).
 bool shared_rows(const Context& cx, const Site&) {
   std::size_t n = 0;
@@ -63,8 +66,11 @@ const std::array<Hypothesis, 16> kTable{{
     {P::nonlinear_gain, S::column, 3, Per::channel, G::beyond_noise, any_column, fit_static_map, say_static_map},
     // a gain set by the output's own level: one slope per output
     {P::nonlinear_gain, S::row, 1, Per::output, G::beyond_noise, shared_row, fit_row_level_gain, say_level_gain},
-    // offered only when it beats the same lag on the disturbances alone
-    {P::sensor_dynamics, S::row, 1, Per::finding, G::beyond_noise, shared_row, fit_sensor, say_sensor},
+    // A sensor lag is itself partly a change of what the disturbances look
+    // like, so the AR(3) gate would take its own lag of the noise from it;
+    // its competitor, the changed disturbance model, stands in the same pool
+    // of candidates, and the selection weighs the two on the same score.
+    {P::sensor_dynamics, S::row, 1, Per::finding, G::held_out, modelled_row, fit_sensor, say_sensor},
     {P::nonlinear_gain, S::plant, 1, Per::output, G::beyond_noise, shared_rows, fit_plant_level_gain,
      say_level_gain},
     // the signal through each modelled channel of the output (a disturbance entering with that input)
@@ -72,7 +78,11 @@ const std::array<Hypothesis, 16> kTable{{
      say_signal_through_channel},
     // first order plus dead time: gain, time constant, delay
     {P::unmodeled_input, S::signal, 3, Per::finding, G::held_out, always, fit_signal_fopdt, say_signal_fopdt},
-    // AR(1..3) or ARMA(1,1) on the whitened residual: the fit chooses the count
+    // AR(1..3) or ARMA(1,1) on the whitened residual: the fit chooses the
+    // count. A candidate of every round, beside the process changes: under
+    // feedback G_M u correlates with a residual whose noise model changed, so
+    // a process form can fit it too, and only the comparison of the two on
+    // the same score tells which explains the output.
     {P::disturbance_model, S::noise, 0, Per::finding, G::held_out, known_noise, fit_disturbance_model,
      say_disturbance_model},
 }};

@@ -31,7 +31,7 @@ enum class Scope {
 // the held-out confirmation (see passes() in diagnosis_score.cpp).
 enum class Gate {
   beyond_noise,  // also explain the residual beyond an AR(3) change of the disturbance model
-  held_out,      // nothing more: a recorded signal is not moved by the controller
+  held_out,      // nothing more (a recorded signal, a sensor lag, a changed disturbance model)
 };
 
 // What the parameter count is counted per.

@@ -4,7 +4,7 @@ every physics word the simulator can make, on random channels, magnitudes and
 seeds, scored as a confusion matrix by word.
 
 usage: scripts/generalisation_bench.py [--mpm build/daemon/mpm] [--runs 200] [--jobs 1] [--seed 1] [--random-fraction 0.5]
-                                       [--out bench.json] [--words gain,deadband]
+                                       [--out bench.json] [--words gain,deadband] [--keep DIR]
 
 Each run draws a plant (Wood-Berry, the 3x3, the nonlinear quadruple tank, or
 a random stable plant: 2-4 inputs and outputs, first- and second-order
@@ -33,6 +33,7 @@ import csv
 import json
 import os
 import random
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -384,6 +385,11 @@ def run_case_once(args, index):
 
 
 def diagnose(args, index, word, key, plant, run, truth, desc, sim_seed, ratio):
+    if args.keep:
+        kept = os.path.join(args.keep, "run%03d" % index)
+        os.makedirs(kept, exist_ok=True)
+        shutil.copy(plant, os.path.join(kept, "plant.yaml"))
+        shutil.copy(run, os.path.join(kept, "run.csv"))
     out = run + ".json"
     r = subprocess.run([args.mpm, "diagnose", "--quiet", "--plant", plant, "--data", run, "--json", out],
                        capture_output=True, text=True)
@@ -482,6 +488,7 @@ def main():
                     help="share of runs on a random plant (words the simulator can edit on any plant)")
     ap.add_argument("--out", default="", help="write the runs and the score as JSON here (never overwritten)")
     ap.add_argument("--verbose", action="store_true", help="one line per run")
+    ap.add_argument("--keep", default="", help="copy each run's plant file and recording to KEEP/runNNN/ (to rerun one)")
     args = ap.parse_args()
     args.words = [w for w in args.words.split(",") if w]
     for w in args.words:

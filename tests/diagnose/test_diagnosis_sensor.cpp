@@ -6,6 +6,7 @@
 // three look alike in the model-predicted part.
 #include <cmath>
 #include <cstddef>
+#include <optional>
 #include <random>
 #include <string>
 #include <tuple>
@@ -45,7 +46,9 @@ Eigen::VectorXd channel(const Eigen::VectorXd& u, double g) {
 
 // Disturbances v = N e with N = 1 / (1 - declared q^-1) as the plant file
 // says, except in the changed-disturbance case (pole `actual` instead).
-dg::Problem one_output(Truth truth, unsigned seed, double declared = 0.8, double actual = 0.95, double sd = 0.1) {
+// Without `u2_drives`, u2 still moves but has no channel into the output.
+dg::Problem one_output(Truth truth, unsigned seed, double declared = 0.8, double actual = 0.95, double sd = 0.1,
+                       bool u2_drives = true) {
   const Eigen::Index n = 6000;
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, sd);
@@ -65,7 +68,7 @@ dg::Problem one_output(Truth truth, unsigned seed, double declared = 0.8, double
   const double pole = truth == Truth::kNoiseModel ? actual : declared;
   double v = 0.0;
   for (Eigen::Index k = 0; k < n; ++k) e(k) = v = pole * v + noise(rng);
-  const double g1 = 0.2, g2 = 0.02;  // u2 barely moves the output
+  const double g1 = 0.2, g2 = u2_drives ? 0.02 : 0.0;  // u2 barely moves the output
   const Eigen::VectorXd gu = channel(u1, g1) + channel(u2, g2);
   Eigen::VectorXd y;
   switch (truth) {
@@ -76,8 +79,9 @@ dg::Problem one_output(Truth truth, unsigned seed, double declared = 0.8, double
   Eigen::MatrixXd du(n, 2);
   du.col(0) = u1;
   du.col(1) = u2;
-  return mpm::test::one_output_problem({"u1", "u2"}, std::move(du), y - gu,
-                                      {DiscreteTf{{g1}, {1.0, -0.8}, 1}, DiscreteTf{{g2}, {1.0, -0.8}, 1}},
+  std::optional<DiscreteTf> second;
+  if (u2_drives) second = DiscreteTf{{g2}, {1.0, -0.8}, 1};
+  return mpm::test::one_output_problem({"u1", "u2"}, std::move(du), y - gu, {DiscreteTf{{g1}, {1.0, -0.8}, 1}, second},
                                       DiscreteTf{{1.0}, {1.0, -declared}, 0}, sd * sd / (1.0 - declared * declared));
 }
 
@@ -96,6 +100,28 @@ TEST(DiagnosisSensor, SensorLagNamesTheWholeOutput) {
     EXPECT_EQ(f.channels.size(), 2u) << "seed " << seed << ": both inputs' channels into the lagged output";
     EXPECT_NEAR(f.parameters.at("sensor_lag_pole"), 0.5, 0.1) << "seed " << seed;
     EXPECT_LT(f.fit.holdout_variance_after, f.fit.holdout_variance_before) << "seed " << seed;
+  }
+}
+
+// One input drives the output: a lag on its channel and a transmitter lag
+// predict the same model output, and only the disturbances, which the
+// transmitter lags too, tell them apart; so they must, both ways.
+TEST(DiagnosisSensor, SensorLagOnAnOutputOneInputDrives) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const dg::Result r = dg::diagnose(one_output(Truth::kSensorLag, seed, 0.8, 0.95, 0.1, false));
+    const std::string what = "seed " + std::to_string(seed) + ": " + describe(r);
+    ASSERT_EQ(r.findings.size(), 1u) << what;
+    const dg::Finding& f = r.findings.front();
+    EXPECT_EQ(f.physics, "sensor_dynamics") << what;
+    ASSERT_EQ(f.channels.size(), 1u) << what;
+    EXPECT_EQ(f.channels[0].input, std::optional<std::size_t>(0)) << what;
+    EXPECT_NEAR(f.parameters.at("sensor_lag_pole"), 0.5, 0.1) << what;
+  }
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const dg::Result r = dg::diagnose(one_output(Truth::kChannelLag, seed, 0.8, 0.95, 0.1, false));
+    const std::string what = "channel lag, seed " + std::to_string(seed) + ": " + describe(r);
+    ASSERT_FALSE(r.findings.empty()) << what;
+    for (const auto& f : r.findings) EXPECT_NE(f.physics, "sensor_dynamics") << what;
   }
 }
 
