@@ -157,6 +157,10 @@ void refresh(Context& cx, std::size_t j);
 // gate; its selection score (BIC on the fit part plus the held-out
 // log-likelihood gain); the fit block of its finding (and the raw one).
 double fit_level(const Settings& s, double family);
+// The fit-part limit of a candidate with `params` parameters, and the limit
+// of its pooled statistic lr + z_hold^2 (see passes()).
+double fit_limit(const Settings& s, double family, int params);
+double pooled_limit(const Settings& s, double family, int params);
 bool passes(const Candidate& c, const Settings& s, double family);
 double selection_score(const Context& cx, const Candidate& c, double log_n);
 FitNumbers fit_numbers(const Context& cx, const Candidate& c, FitNumbers& raw);

@@ -181,11 +181,28 @@ void score(const Context& cx, Candidate& c) {
 // (held-out level): the fit level is alpha / hold level, shared over the family.
 double fit_level(const Settings& s, double family) { return s.alpha / s.holdout_level / family; }
 
-// The row's gate (see score() for the test against a changed disturbance
+double fit_limit(const Settings& s, double family, int params) {
+  return chi_square_quantile_upper(0.5 * fit_level(s, family), params);
+}
+
+double pooled_limit(const Settings& s, double family, int params) {
+  return chi_square_quantile_upper(0.5 * s.alpha / family, params + 1);
+}
+
+// The evidence, at the family-wise level alpha split in halves: either the
+// fit-part test and the held-out test both pass (independent under "no
+// mismatch", so together at (fit level / 2) x (held-out level)), or the two
+// parts' evidence pooled, lr + z^2 with z > 0 (chi-square with one degree of
+// freedom more), passes at alpha / 2 over the family. The first keeps a
+// strong fit whose held-out part only confirms it; the second a fit just
+// under its limit whose held-out part speaks clearly (a weak channel's gain:
+// fit LR 7 against 12.6, z 4.6). Then the held-out variance must drop, and
+// the row's gate (see score() for the test against a changed disturbance
 // model, and the table's rows for who is held to it).
 bool passes(const Candidate& c, const Settings& s, double family) {
-  return c.lr >= chi_square_quantile_upper(fit_level(s, family), c.params) && c.z_hold >= s.holdout_z &&
-         c.hold_gain > 0.0 &&
+  const bool both = c.lr >= fit_limit(s, family, c.params) && c.z_hold >= s.holdout_z;
+  const bool pooled = c.z_hold > 0.0 && c.lr + c.z_hold * c.z_hold >= pooled_limit(s, family, c.params);
+  return (both || pooled) && c.hold_gain > 0.0 &&
          (c.hypothesis->gate != Gate::beyond_noise ||
           c.lr_beyond_noise >= chi_square_quantile_upper(s.beyond_noise_level, c.params));
 }
