@@ -1,5 +1,7 @@
 // The measurement plan of `mpm bench`: which figures, in which order, with how
 // many repetitions (full run well under 2 minutes, --quick a smoke test).
+#include <algorithm>
+#include <cstdarg>
 #include <cstdio>
 #include <string>
 #include <utility>
@@ -27,11 +29,19 @@ struct Size {
   std::size_t repeats;
 };
 
-template <typename... Numbers>
-std::string fmt(const char* format, Numbers... values) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, format, static_cast<double>(values)...);
-  return buf;
+// printf into a string of the length it takes; the attribute has the
+// compiler check every call's arguments against its format.
+[[gnu::format(printf, 1, 2)]] std::string fmt(const char* format, ...) {
+  std::va_list args;
+  va_start(args, format);
+  std::va_list again;
+  va_copy(again, args);
+  const int length = std::vsnprintf(nullptr, 0, format, args);
+  va_end(args);
+  std::string text(static_cast<std::size_t>(std::max(length, 0)), '\0');
+  std::vsnprintf(text.data(), text.size() + 1, format, again);
+  va_end(again);
+  return text;
 }
 
 std::string tag(std::size_t n) { return std::to_string(n) + "x" + std::to_string(n); }
@@ -78,23 +88,18 @@ void memory_figures(Plan& plan) {
       plan.add(name, std::nullopt, "MB", failed);
       continue;
     }
-    char text[768];
-    std::snprintf(text, sizeof text,
-                  "VmRSS of mpmd (pid %d, %s) monitoring a %s plant (%s; na=20 nb=10 lambda=0.999, "
-                  "model-filtered regressors, gamma on) after %zu samples over LCM (%s), all processed (its status: "
-                  "%zu seen, %zu used by the monitor); VmHWM %.1f MB; RssAnon %.1f MB (heap: monitor, models, "
-                  "queues, buffers), RssFile %.1f MB (executable, shared libraries); at READY=1, monitor built and "
-                  "no sample yet: VmRSS %.1f MB",
-                  static_cast<int>(m->pid), mpmd->c_str(), tag(n).c_str(),
-                  n == 2 ? "Wood-Berry" : "generated, first order plus dead time per channel", m->samples_sent,
-                  m->url.c_str(), m->samples_seen, m->samples_used, m->hwm_mb, m->anon_mb, m->file_mb,
-                  m->ready_rss_mb);
-    std::string note = text;
+    std::string note =
+        fmt("VmRSS of mpmd (pid %d, %s) monitoring a %s plant (%s; na=20 nb=10 lambda=0.999, "
+            "model-filtered regressors, gamma on) after %zu samples over LCM (%s), all processed (its status: "
+            "%zu seen, %zu used by the monitor); VmHWM %.1f MB; RssAnon %.1f MB (heap: monitor, models, "
+            "queues, buffers), RssFile %.1f MB (executable, shared libraries); at READY=1, monitor built and "
+            "no sample yet: VmRSS %.1f MB",
+            static_cast<int>(m->pid), mpmd->c_str(), tag(n).c_str(),
+            n == 2 ? "Wood-Berry" : "generated, first order plus dead time per channel", m->samples_sent,
+            m->url.c_str(), m->samples_seen, m->samples_used, m->hwm_mb, m->anon_mb, m->file_mb, m->ready_rss_mb);
     if (anon_2x2) {
-      std::snprintf(text, sizeof text, "; what grows with the plant (monitor, models): about %.1f MB (RssAnon "
-                                       "minus the 2x2 run's)",
-                    m->anon_mb - *anon_2x2);
-      note += text;
+      note += fmt("; what grows with the plant (monitor, models): about %.1f MB (RssAnon minus the 2x2 run's)",
+                  m->anon_mb - *anon_2x2);
     }
     if (n == 2) anon_2x2 = m->anon_mb;
     plan.add(name, m->rss_mb, "MB", note);
@@ -239,17 +244,15 @@ void diagnose_figure(Plan& plan) {
     plan.add(name, std::nullopt, "samples/s", why);
     return;
   }
-  char text[1024];
-  std::snprintf(text, sizeof text,
-                "%zu-sample closed-loop recording of scenario %s (seed 1; built-in wood-berry.yaml) written to "
-                "temporary files, then diagnosed as `mpm diagnose --quiet` does, by the same library calls in this "
-                "process (not the mpm binary; the same daemon/offline functions as the command): load and "
-                "parse plant YAML and CSV, bind, residuals, Granger monitor (forgetting 1) over %zu threads, "
-                "structured hypotheses (core/diagnosis.hpp, generators on every core); JSON report not timed; wall-clock, median of %zu "
-                "runs (fastest %.0f samples/s; %.2f s wall, %.2f s process CPU)",
-                d->samples, d->scenario.c_str(), d->threads, d->repeats, d->fastest_samples_per_s, d->wall_seconds,
-                d->cpu_seconds);
-  std::string note = text;
+  const std::string note =
+      fmt("%zu-sample closed-loop recording of scenario %s (seed 1; built-in wood-berry.yaml) written to "
+          "temporary files, then diagnosed as `mpm diagnose --quiet` does, by the same library calls in this "
+          "process (not the mpm binary; the same daemon/offline functions as the command): load and "
+          "parse plant YAML and CSV, bind, residuals, Granger monitor (forgetting 1) over %zu threads, "
+          "structured hypotheses (core/diagnosis.hpp, generators on every core); JSON report not timed; wall-clock, "
+          "median of %zu runs (fastest %.0f samples/s; %.2f s wall, %.2f s process CPU)",
+          d->samples, d->scenario.c_str(), d->threads, d->repeats, d->fastest_samples_per_s, d->wall_seconds,
+          d->cpu_seconds);
   if (!d->found_planted) {
     plan.add(name, std::nullopt, "samples/s",
              "the diagnosis did not name the planted channel " + d->planted + " (found: " + d->findings +

@@ -28,13 +28,7 @@ Workload make_workload(std::size_t inputs, std::size_t outputs, std::size_t samp
   return w;
 }
 
-MonitorSettings paper_settings() {
-  MonitorSettings s;
-  s.ar_order = 20;
-  s.input_order = 10;
-  s.forgetting = 0.999;
-  return s;
-}
+MonitorSettings paper_settings() { return {.ar_order = 20, .input_order = 10, .forgetting = 0.999}; }
 
 std::vector<std::optional<std::vector<double>>> ar1_noise_models(std::size_t outputs, int ar_order) {
   DiscreteTf n;

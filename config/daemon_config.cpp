@@ -15,12 +15,6 @@ namespace {
 using detail::Field;
 using detail::YamlReader;
 
-ConfigError yaml_error(const YAML::Exception& e, const std::string& source, const char* what) {
-  const std::string where =
-      e.mark.is_null() ? "" : std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ":";
-  return ConfigError(source + ":" + where + " " + what + ": " + e.msg);
-}
-
 // exists() without its throwing overload: a path too long or otherwise
 // unusable is "not there" (the caller names the key), never a
 // filesystem_error without file or line.
@@ -165,14 +159,8 @@ const std::vector<FieldRow<DaemonConfig>>& DaemonConfig::fields() {
 DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string& source_name,
                                  const std::string& base_dir) {
   const YamlReader r(source_name);
-  YAML::Node document;
-  try {
-    document = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw yaml_error(e, source_name, "invalid YAML");
-  }
-  const Field root = r.root(document);
-  try {
+  const Field root = r.root(detail::load_document(yaml_text, source_name));
+  return detail::read_checked(source_name, [&] {
     r.check_keys(root, keys_of(DaemonConfig::fields(), keys_of(ServiceSettings::fields(),
                                                                 {"controller_id", "plant", "monitor", "transport", "limits"})));
     DaemonConfig c;
@@ -186,9 +174,7 @@ DaemonConfig parse_daemon_config(const std::string& yaml_text, const std::string
     read_top_level(r, root, base_dir, c);
     read_limits(r, root, c);
     return c;
-  } catch (const YAML::Exception& e) {
-    throw yaml_error(e, source_name, "unexpected structure");
-  }
+  });
 }
 
 DaemonConfig load_daemon_config(const std::string& path) {

@@ -3,27 +3,39 @@
 #include <cmath>
 #include <cstdio>
 
+#include "config/text_escape.hpp"
+
 namespace mpm::config {
 
+namespace {
+
+// JSON's escapes: quote, backslash, \n and \t by name, the other control
+// characters as \u00XX.
+const EscapeTable& json_escapes() {
+  static const EscapeTable table = [] {
+    EscapeTable t;
+    for (std::size_t c = 0; c < 0x20; ++c) {
+      char b[8];
+      std::snprintf(b, sizeof b, "\\u%04x", static_cast<unsigned>(c));
+      t[c] = b;
+    }
+    t['"'] = "\\\"";
+    t['\\'] = "\\\\";
+    t['\n'] = "\\n";
+    t['\t'] = "\\t";
+    return t;
+  }();
+  return table;
+}
+
+}  // namespace
+
+// Built by append: GCC 12 warns falsely (-Wrestrict) on "literal" + string.
 std::string json_string(const std::string& s) {
   std::string o = "\"";
-  for (char c : s) {
-    switch (c) {
-      case '"': o += "\\\""; break;
-      case '\\': o += "\\\\"; break;
-      case '\n': o += "\\n"; break;
-      case '\t': o += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char b[8];
-          std::snprintf(b, sizeof b, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
-          o += b;
-        } else {
-          o += c;
-        }
-    }
-  }
-  return o + "\"";
+  o += escaped(s, json_escapes());
+  o += '"';
+  return o;
 }
 
 std::string json_number(double v, int digits) {

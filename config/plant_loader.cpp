@@ -15,22 +15,6 @@ namespace {
 using detail::Field;
 using detail::YamlReader;
 
-// e.what() repeats the position in yaml-cpp's own words; use the bare msg.
-ConfigError from_yaml_error(const YAML::Exception& e, const std::string& source, const char* what) {
-  const std::string where = e.mark.is_null() ? ""
-                                             : std::to_string(e.mark.line + 1) + ":" +
-                                                   std::to_string(e.mark.column + 1) + ":";
-  return ConfigError(source + ":" + where + " " + what + ": " + e.msg);
-}
-
-YAML::Node load_yaml(const std::string& text, const std::string& source) {
-  try {
-    return YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw from_yaml_error(e, source, "invalid YAML");
-  }
-}
-
 // Names become CSV column names: they must be unique across inputs and
 // outputs, not clash with the time column or the sim_/r_ columns derived
 // from output names, and be writable in a plain CSV header.
@@ -156,8 +140,8 @@ void read_operating_point(const YamlReader& reader, const Field& root, PlantMode
 PlantModel parse_plant(const std::string& yaml_text, const std::string& source_name,
                        const Limits& limits) {
   const YamlReader reader(source_name);
-  const Field root = reader.root(load_yaml(yaml_text, source_name));
-  try {
+  const Field root = reader.root(detail::load_document(yaml_text, source_name));
+  return detail::read_checked(source_name, [&] {
     reader.check_keys(
         root, {"plant", "sample_time", "inputs", "outputs", "model", "state_space", "noise", "operating_point"});
     PlantModel plant;
@@ -166,11 +150,7 @@ PlantModel parse_plant(const std::string& yaml_text, const std::string& source_n
     read_noise(reader, root, limits, plant);
     read_operating_point(reader, root, plant);
     return plant;
-  } catch (const YAML::Exception& e) {
-    // Every access is checked first; this is a net for a case we missed, so
-    // that a yaml-cpp message never escapes without the file name.
-    throw from_yaml_error(e, source_name, "unexpected structure");
-  }
+  });
 }
 
 PlantModel load_plant(const std::string& path, const Limits& limits) {

@@ -94,6 +94,18 @@ void YamlReader::fail(const Field& at, const std::string& what) const {
   throw ConfigError(message);
 }
 
+void fail_from_yaml(const YAML::Exception& e, const std::string& source, const char* what) {
+  throw ConfigError(source + ":" + position(e.mark) + " " + what + ": " + e.msg);
+}
+
+YAML::Node load_document(const std::string& text, const std::string& source) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    fail_from_yaml(e, source, "invalid YAML");
+  }
+}
+
 void YamlReader::fail_expected(const Field& at, const std::string& expected) const {
   fail(at, "expected " + expected + ", got " + describe(at.node));
 }

@@ -61,4 +61,23 @@ class YamlReader {
 // Human description of a node for "got ..." in messages.
 std::string describe(const YAML::Node& node);
 
+// Throws ConfigError "<source>:<line>:<col>: <what>: <yaml-cpp's message>"
+// (e.what() repeats the position in yaml-cpp's own words: the bare msg).
+[[noreturn]] void fail_from_yaml(const YAML::Exception& e, const std::string& source, const char* what);
+
+// The document in `text`; a syntax error fails as "invalid YAML".
+YAML::Node load_document(const std::string& text, const std::string& source);
+
+// read(), whose every access is checked first: a yaml-cpp exception that
+// still escapes is a case the checks missed, and must not leave without the
+// file name, so it fails as "unexpected structure".
+template <class Read>
+auto read_checked(const std::string& source, Read&& read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const YAML::Exception& e) {
+    fail_from_yaml(e, source, "unexpected structure");
+  }
+}
+
 }  // namespace mpm::config::detail

@@ -25,7 +25,7 @@ struct MonitorSettings {
                                  // (record_verdict) per channel and test, and the
                                  // level at which a raise's conditional score
                                  // names a channel on its own
-  DetectorSettings detector;     // live alarms: stated rate per unit time
+  DetectorSettings detector{};   // live alarms: stated rate per unit time
   double outlier_limit = 10.0;   // skip a sample whose residual moves more than
                                  // this many robust standard deviations of its
                                  // recent one-step changes (0 = never)

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "config/json_text.hpp"
+#include "config/text_escape.hpp"
 #include "core/monitor_front_end.hpp"
 #include "core/paper_plots.hpp"
 #include "core/transfer_function.hpp"
@@ -35,30 +36,34 @@ std::string tag(const char* prefix, std::size_t n) {
   return s;
 }
 
+// HTML text and attribute values.
 std::string esc(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '&': o += "&amp;"; break;
-      case '"': o += "&quot;"; break;
-      default: o += c;
-    }
-  }
-  return o;
+  static const config::EscapeTable table = [] {
+    config::EscapeTable t;
+    t['<'] = "&lt;";
+    t['>'] = "&gt;";
+    t['&'] = "&amp;";
+    t['"'] = "&quot;";
+    return t;
+  }();
+  return config::escaped(s, table);
 }
 
-// A JavaScript string literal (also safe inside <script>: no "</").
+// A JavaScript string literal (also safe inside <script>: no "</"); control
+// characters become spaces.
 std::string js_string(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (c == '<') { o += "\\u003c"; continue; }
-    if (static_cast<unsigned char>(c) < 0x20) { o += ' '; continue; }
-    o += c;
-  }
-  return o + "\"";
+  static const config::EscapeTable table = [] {
+    config::EscapeTable t;
+    for (std::size_t c = 0; c < 0x20; ++c) t[c] = " ";
+    t['"'] = "\\\"";
+    t['\\'] = "\\\\";
+    t['<'] = "\\u003c";
+    return t;
+  }();
+  std::string o = "\"";  // appended to: see tag()
+  o += config::escaped(s, table);
+  o += '"';
+  return o;
 }
 
 // G u from rest, u a deviation series.

@@ -31,42 +31,70 @@ struct OutputEdit {
 void validate(const InputEdit& e);
 void validate(const OutputEdit& e);
 
-class InputStage {
+// One input's actuator (InputEdit); default: ideal, the command passes.
+class Actuator {
  public:
-  InputStage() = default;
-  // edits: (input index, edit); inputs without an edit pass through unchanged.
-  InputStage(std::size_t n_inputs, const std::vector<std::pair<std::size_t, InputEdit>>& edits);
+  using Edit = InputEdit;
+  Actuator() = default;
+  explicit Actuator(const InputEdit& e);
 
-  // Real-time safe. command -> effective input of the process.
-  void apply(const double* command, double* effective) noexcept;
-  void reset() noexcept;
-  std::size_t size() const noexcept { return actuators_.size(); }
+  double step(double command) noexcept;  // command -> effective input
+  void reset() noexcept { backlash_out_ = lag_out_ = 0.0; }
 
  private:
-  struct Actuator {
-    double lag_pole = 0.0;
-    double lower = -std::numeric_limits<double>::infinity();
-    double upper = std::numeric_limits<double>::infinity();
-    double half_width = 0.0;
-    double backlash_out = 0.0;  // state: where the backlash left the stem
-    double lag_out = 0.0;       // state: actuator lag output
-  };
-  std::vector<Actuator> actuators_;
+  double lag_pole_ = 0.0;
+  double lower_ = -std::numeric_limits<double>::infinity();
+  double upper_ = std::numeric_limits<double>::infinity();
+  double half_width_ = 0.0;
+  double backlash_out_ = 0.0;  // state: where the backlash left the stem
+  double lag_out_ = 0.0;       // state: actuator lag output
 };
 
-class OutputStage {
+// One output's transmitter (OutputEdit); default: ideal, the value passes.
+class Sensor {
  public:
-  OutputStage() = default;
-  OutputStage(std::size_t n_outputs, const std::vector<std::pair<std::size_t, OutputEdit>>& edits);
+  using Edit = OutputEdit;
+  Sensor() = default;
+  explicit Sensor(const OutputEdit& e) : lag_pole_(e.sensor_lag_pole) {}
 
-  // Real-time safe. process output + disturbance -> measured output.
-  void apply(const double* value, double* measured) noexcept;
-  void reset() noexcept;
-  std::size_t size() const noexcept { return state_.size(); }
+  double step(double value) noexcept {  // process output + disturbance -> measured
+    state_ = lag_pole_ * state_ + (1.0 - lag_pole_) * value;
+    return state_;
+  }
+  void reset() noexcept { state_ = 0.0; }
 
  private:
-  std::vector<double> lag_pole_;
-  std::vector<double> state_;
+  double lag_pole_ = 0.0;
+  double state_ = 0.0;
 };
+
+// One Element (Actuator or Sensor) per channel, stepped and reset together.
+template <class Element>
+class ChannelStage {
+ public:
+  ChannelStage() = default;
+  // edits: (channel index, edit); channels without an edit pass through
+  // unchanged. Throws std::invalid_argument for a bad edit or index.
+  ChannelStage(std::size_t n_channels, const std::vector<std::pair<std::size_t, typename Element::Edit>>& edits);
+
+  // Real-time safe.
+  void apply(const double* in, double* out) noexcept {
+    for (std::size_t i = 0; i < elements_.size(); ++i) out[i] = elements_[i].step(in[i]);
+  }
+  void reset() noexcept {
+    for (Element& e : elements_) e.reset();
+  }
+  std::size_t size() const noexcept { return elements_.size(); }
+
+ private:
+  std::vector<Element> elements_;
+};
+
+// Instantiated once, in instruments.cpp, where the constructor is.
+extern template class ChannelStage<Actuator>;
+extern template class ChannelStage<Sensor>;
+
+using InputStage = ChannelStage<Actuator>;  // command -> effective input of the process
+using OutputStage = ChannelStage<Sensor>;   // process output + disturbance -> measured output
 
 }  // namespace mpm::sim

@@ -45,20 +45,19 @@ class LcmTransport final : public Transport {
   bool good() const { return lcm_ != nullptr; }
 
   bool subscribe_samples(SampleHandler handler) override {
-    on_sample_ = std::move(handler);
-    return subscribe(settings_.sample_channel, routes_[0], &LcmTransport::receive_sample);
+    return subscribe(settings_.sample_channel, on_sample_, std::move(handler), routes_[0],
+                     &LcmTransport::receive_sample);
   }
   bool subscribe_alarms(AlarmHandler handler) override {
-    on_alarm_ = std::move(handler);
-    return subscribe(settings_.alarm_channel, routes_[1], &LcmTransport::receive_alarm);
+    return subscribe(settings_.alarm_channel, on_alarm_, std::move(handler), routes_[1], &LcmTransport::receive_alarm);
   }
   bool subscribe_status(StatusHandler handler) override {
-    on_status_ = std::move(handler);
-    return subscribe(settings_.status_channel, routes_[2], &LcmTransport::receive_status);
+    return subscribe(settings_.status_channel, on_status_, std::move(handler), routes_[2],
+                     &LcmTransport::receive_status);
   }
   bool subscribe_diagnoses(DiagnosisHandler handler) override {
-    on_diagnosis_ = std::move(handler);
-    return subscribe(settings_.diagnosis_channel, routes_[3], &LcmTransport::receive_diagnosis);
+    return subscribe(settings_.diagnosis_channel, on_diagnosis_, std::move(handler), routes_[3],
+                     &LcmTransport::receive_diagnosis);
   }
 
   bool publish(const msg::Sample& sample) override { return send(settings_.sample_channel, sample, tx_sample_); }
@@ -99,7 +98,11 @@ class LcmTransport final : public Transport {
     (r->self->*r->receive)(rbuf);
   }
 
-  bool subscribe(const std::string& channel, Route& route, Receive decode) {
+  // `handler` kept in `slot`, then `channel` subscribed with `decode` as its
+  // receiver (LCM calls it back only from handle(), so the order is free).
+  template <typename Handler>
+  bool subscribe(const std::string& channel, Handler& slot, Handler handler, Route& route, Receive decode) {
+    slot = std::move(handler);
     route = Route{this, decode};
     lcm_subscription_t* sub = lcm_subscribe(lcm_, channel.c_str(), &LcmTransport::dispatch, &route);
     if (sub == nullptr) return false;

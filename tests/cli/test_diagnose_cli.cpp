@@ -15,24 +15,22 @@
 
 namespace {
 
-const std::string kWoodBerry = std::string(MPM_SOURCE_DIR) + "/config/wood-berry.yaml";
+using namespace mpm::test;  // kMpm, config_file, read_file, run_quietly, ...
 
-using mpm::test::kMpm;
-using mpm::test::read_file;
+const std::string kWoodBerry = config_file("wood-berry.yaml");
 
 std::string tmp_path(const std::string& name) { return mpm::test::tmp_path("mpm_diag_", name); }
-int run(const std::string& cmd) { return mpm::test::run_quietly(cmd); }
 
-const std::string kQuadTank = std::string(MPM_SOURCE_DIR) + "/config/quad-tank.yaml";
+const std::string kQuadTank = config_file("quad-tank.yaml");
 
 // Simulates a scenario and diagnoses it against `plant`; returns the report text.
 std::string diagnose_scenario(const std::string& scenario, int seed, int samples = 3000,
                               const std::string& plant = kWoodBerry) {
   const std::string csv = tmp_path(scenario + ".csv"), out = tmp_path(scenario + ".json");
-  EXPECT_EQ(run(kMpm + " simulate --scenario " + scenario + " --samples " + std::to_string(samples) + " --seed " +
-                std::to_string(seed) + " --out " + csv),
+  EXPECT_EQ(run_quietly(kMpm + " simulate --scenario " + scenario + " --samples " + std::to_string(samples) +
+                        " --seed " + std::to_string(seed) + " --out " + csv),
             0);
-  EXPECT_EQ(run(kMpm + " diagnose --quiet --plant " + plant + " --data " + csv + " --json " + out), 0);
+  EXPECT_EQ(run_quietly(kMpm + " diagnose --quiet --plant " + plant + " --data " + csv + " --json " + out), 0);
   return read_file(out);
 }
 
@@ -134,7 +132,7 @@ TEST(DiagnoseCli, QuadTankNearItsLinearisationGivesNoFinding) {
 // the same sample can only be the controller's (u(k) is computed from
 // y(k)), and no finding may claim one (a missing channel or a dead time of 0).
 TEST(DiagnoseCli, MissingChannelIsNamedAndNoFindingRespondsWithinTheSample) {
-  const std::string model = read_file(std::string(MPM_SOURCE_DIR) + "/config/three-by-three.yaml");
+  const std::string model = read_file(config_file("three-by-three.yaml"));
   const std::string anchor = "  - output: y2\n    input: u1\n";
   const std::size_t at = model.find(anchor);
   ASSERT_NE(at, std::string::npos);
@@ -146,11 +144,11 @@ TEST(DiagnoseCli, MissingChannelIsNamedAndNoFindingRespondsWithinTheSample) {
   }
   for (int seed : {71, 73}) {
     const std::string csv = tmp_path("y1u3.csv"), out = tmp_path("y1u3.json");
-    ASSERT_EQ(run(kMpm + " simulate --scenario plant-nominal --plant " + with_channel +
+    ASSERT_EQ(run_quietly(kMpm + " simulate --scenario plant-nominal --plant " + with_channel +
                   " --move-weight-scale 0.001 --seed " + std::to_string(seed) + " --out " + csv),
               0);
-    ASSERT_EQ(run(kMpm + " diagnose --quiet --plant " + std::string(MPM_SOURCE_DIR) +
-                  "/config/three-by-three.yaml --data " + csv + " --json " + out),
+    ASSERT_EQ(run_quietly(kMpm + " diagnose --quiet --plant " + config_file("three-by-three.yaml") +
+                          " --data " + csv + " --json " + out),
               0);
     const std::string r = read_file(out);
     EXPECT_EQ(physics_words(r), std::set<std::string>{"missing_channel"}) << "seed " << seed << ":\n" << r;
@@ -196,15 +194,15 @@ TEST(DiagnoseCli, ChangedDisturbancesAreNotTakenForAProcessChange) {
 // loop diverges. The plant is the channel followed by an integrator.
 TEST(DiagnoseCli, IntegratorOnTheFourByFoursFastChannelIsNamed) {
   const std::string r = diagnose_scenario("quad-tank-g32-integrator", 5, 3000,
-                                          std::string(MPM_SOURCE_DIR) + "/config/quad-tank-4x4.yaml");
+                                          config_file("quad-tank-4x4.yaml"));
   EXPECT_EQ(physics_words(r), std::set<std::string>{"integrator"}) << r;
   EXPECT_TRUE(names_channel(r, "y3", "\"u2\"")) << r;
   EXPECT_NE(r.find("diverging"), std::string::npos) << r;  // and the report says the loop diverges
 }
 
 TEST(DiagnoseCli, ErrorsNameTheFileAndUseExitCodes) {
-  EXPECT_EQ(WEXITSTATUS(run(kMpm + " diagnose --plant " + kWoodBerry)), 2);                       // --data missing
-  EXPECT_EQ(WEXITSTATUS(run(kMpm + " diagnose --plant " + kWoodBerry + " --data /nonexistent.csv")), 1);
+  EXPECT_EQ(WEXITSTATUS(run_quietly(kMpm + " diagnose --plant " + kWoodBerry)), 2);  // --data missing
+  EXPECT_EQ(WEXITSTATUS(run_quietly(kMpm + " diagnose --plant " + kWoodBerry + " --data /nonexistent.csv")), 1);
   const std::string err = tmp_path("err.txt");
   std::system((kMpm + " diagnose --plant " + kWoodBerry + " --data /nonexistent.csv 2>" + err).c_str());
   EXPECT_NE(read_file(err).find("/nonexistent.csv"), std::string::npos);
@@ -217,7 +215,7 @@ class DiagnoseOutput : public ::testing::Test {
  protected:
   void SetUp() override {
     csv_ = mpm::test::per_test_tmp_path("mpm_diag_out_", "run.csv");
-    ASSERT_EQ(run(kMpm + " simulate --scenario wood-berry-nominal --samples 600 --seed 3 --out " + csv_), 0);
+    ASSERT_EQ(run_quietly(kMpm + " simulate --scenario wood-berry-nominal --samples 600 --seed 3 --out " + csv_), 0);
   }
   mpm::test::CliRun diagnose(const std::string& data, const std::string& tail) const {
     return mpm::test::run_captured(kMpm + " diagnose --quiet --plant " + kWoodBerry + " --data " + data + tail,
@@ -280,7 +278,7 @@ TEST(SimulateOutput, OutEqualToPlantIsRefused) {
 // exactly what the whole-record parallel replay gives, also with gaps.
 TEST(MonitorStream, SameResultAsWholeRecordReplay) {
   const std::string csv = mpm::test::per_test_tmp_path("mpm_mon_stream_", "run.csv");
-  ASSERT_EQ(run(kMpm + " simulate --scenario wood-berry-g21-gain --samples 4000 --seed 7 --out " + csv), 0);
+  ASSERT_EQ(run_quietly(kMpm + " simulate --scenario wood-berry-g21-gain --samples 4000 --seed 7 --out " + csv), 0);
   // Punch NaN gaps into u2 and y1 (rows 1500..1519 and 3000).
   std::string text = read_file(csv), gapped;
   std::size_t line = 0, at = 0;

@@ -10,17 +10,15 @@
 
 namespace {
 
-const std::string kQuadTank = std::string(MPM_SOURCE_DIR) + "/config/quad-tank-4x4.yaml";
+using namespace mpm::test;  // kMpm, config_file, read_file, run_quietly, ...
 
-using mpm::test::kMpm;
-using mpm::test::read_file;
+const std::string kQuadTank = config_file("quad-tank-4x4.yaml");
 
 std::string tmp_path(const std::string& name) { return mpm::test::tmp_path("mpm_monitor_", name); }
-int run(const std::string& cmd) { return mpm::test::run_quietly(cmd); }
 
 TEST(MonitorCli, ThreadsDoNotChangeTheReport) {
   const std::string csv = tmp_path("g23.csv");
-  ASSERT_EQ(run(kMpm + " simulate --scenario quad-tank-g23-order --samples 4000 --seed 3 --out " + csv), 0);
+  ASSERT_EQ(run_quietly(kMpm + " simulate --scenario quad-tank-g23-order --samples 4000 --seed 3 --out " + csv), 0);
   std::string reports[3];
   const int threads[3] = {1, 2, 4};
   for (int t = 0; t < 3; ++t) {
@@ -42,8 +40,8 @@ TEST(MonitorCli, JsonHasNoNanOrInfinityAfterHugeValues) {
   // the factor overflows and the output restarts): every number printed is
   // finite or null.
   const std::string csv = tmp_path("huge.csv");
-  const std::string plant = std::string(MPM_SOURCE_DIR) + "/config/wood-berry.yaml";
-  ASSERT_EQ(run(kMpm + " simulate --scenario wood-berry-nominal --samples 3000 --seed 2 --out " + csv), 0);
+  const std::string plant = config_file("wood-berry.yaml");
+  ASSERT_EQ(run_quietly(kMpm + " simulate --scenario wood-berry-nominal --samples 3000 --seed 2 --out " + csv), 0);
   std::string text = read_file(csv), edited;
   std::size_t line = 0, pos = 0, y1 = 0;
   {
@@ -85,8 +83,8 @@ TEST(MonitorCli, JsonHasNoNanOrInfinityAfterHugeValues) {
 
 TEST(MonitorCli, EventsAreJsonLinesOfRaises) {
   const std::string csv = tmp_path("g21.csv");
-  const std::string plant = std::string(MPM_SOURCE_DIR) + "/config/wood-berry.yaml";
-  ASSERT_EQ(run(kMpm + " simulate --scenario wood-berry-g21-gain --samples 12000 --seed 1 --out " + csv), 0);
+  const std::string plant = config_file("wood-berry.yaml");
+  ASSERT_EQ(run_quietly(kMpm + " simulate --scenario wood-berry-g21-gain --samples 12000 --seed 1 --out " + csv), 0);
   const std::string out = tmp_path("events.jsonl");
   ASSERT_EQ(std::system((kMpm + " monitor --forgetting 0.999 --plant " + plant + " --data " + csv + " --events > " + out +
                          " 2>/dev/null").c_str()),
@@ -98,7 +96,8 @@ TEST(MonitorCli, EventsAreJsonLinesOfRaises) {
 }
 
 TEST(MonitorCli, RejectsZeroThreads) {
-  EXPECT_EQ(WEXITSTATUS(run(kMpm + " monitor --plant " + kQuadTank + " --data /nonexistent.csv --threads 0")), 2);
+  EXPECT_EQ(WEXITSTATUS(run_quietly(kMpm + " monitor --plant " + kQuadTank + " --data /nonexistent.csv --threads 0")),
+            2);
 }
 
 }  // namespace
@@ -110,8 +109,8 @@ namespace {
 // raised; a bad cap is a usage error naming the flag and its range.
 TEST(MonitorCli, LimitFlagsSetTheLoadersCaps) {
   const std::string csv = tmp_path("wb.csv");
-  ASSERT_EQ(run(kMpm + " simulate --scenario wood-berry-nominal --samples 2000 --seed 1 --out " + csv), 0);
-  std::string plant = read_file(std::string(MPM_SOURCE_DIR) + "/config/wood-berry.yaml");
+  ASSERT_EQ(run_quietly(kMpm + " simulate --scenario wood-berry-nominal --samples 2000 --seed 1 --out " + csv), 0);
+  std::string plant = read_file(config_file("wood-berry.yaml"));
   const auto at = plant.find("delay: 8");
   ASSERT_NE(at, std::string::npos);
   plant.replace(at, 8, "delay: 1500");
@@ -122,11 +121,11 @@ TEST(MonitorCli, LimitFlagsSetTheLoadersCaps) {
   EXPECT_EQ(WEXITSTATUS(std::system((cmd + " > /dev/null 2> " + err).c_str())), 1);
   EXPECT_NE(read_file(err).find("model[2].delay: expected a delay in 0..1000 samples, got 1500"), std::string::npos)
       << read_file(err);
-  EXPECT_EQ(run(cmd + " --max-delay-samples 2000"), 0);
+  EXPECT_EQ(run_quietly(cmd + " --max-delay-samples 2000"), 0);
   EXPECT_EQ(WEXITSTATUS(std::system((cmd + " --max-delay-samples 1e9 > /dev/null 2> " + err).c_str())), 2);
   EXPECT_NE(read_file(err).find("--max-delay-samples: expected a whole number in 0..10000000"), std::string::npos)
       << read_file(err);
-  EXPECT_EQ(WEXITSTATUS(run(cmd + " --max-csv-columns 3")), 1) << "7 columns over a cap of 3";
+  EXPECT_EQ(WEXITSTATUS(run_quietly(cmd + " --max-csv-columns 3")), 1) << "7 columns over a cap of 3";
 }
 
 }  // namespace

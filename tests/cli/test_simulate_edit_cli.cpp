@@ -38,7 +38,7 @@ std::string recording(const std::string& name, const std::string& scenario, cons
 TEST(SimulateEditCli, GainEditEqualsTheChannelEditInCode) {
   const std::string cli = recording("cli_gain", "wood-berry-nominal", "--edit y2.u1.gain=1.5");
 
-  const mpm::PlantModel model = mpm::config::load_plant(std::string(MPM_SOURCE_DIR) + "/config/wood-berry.yaml");
+  const mpm::PlantModel model = mpm::config::load_plant(mpm::test::config_file("wood-berry.yaml"));
   mpm::sim::LoopConfig loop = mpm::sim::find_scenario("wood-berry-nominal")->loop;
   mpm::sim::ChannelEdit g21;
   g21.output = "y2";

@@ -4,7 +4,9 @@
 // the streaming reader; every other dialect a clear error naming the file
 // and the line.
 #include <cmath>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -37,6 +39,25 @@ std::string read_error(const std::string& text, const std::string& tag) {
   return both.error;
 }
 
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// `rec` has these columns and these rows (kNaN where a field is empty or nan).
+void expect_table(const Recording& rec, const std::vector<std::string>& names,
+                  const std::vector<std::vector<double>>& rows) {
+  ASSERT_EQ(rec.names, names);
+  ASSERT_EQ(rec.samples(), rows.size());
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      const double got = rec.data(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(c));
+      if (std::isnan(rows[k][c])) {
+        EXPECT_TRUE(std::isnan(got)) << "row " << k << ", column " << names[c] << ": " << got;
+      } else {
+        EXPECT_EQ(got, rows[k][c]) << "row " << k << ", column " << names[c];
+      }
+    }
+  }
+}
+
 TEST(CsvDialects, Iso8601TimesBecomeSecondsAndTheStepIsChecked) {
   const Recording good = read_ok(
       "t,u1,y1\n2026-11-25T08:00:00Z,1,2\n2026-11-25 08:00:01,1,2\n2026-11-25T09:00:02+01:00,1,2\n"
@@ -66,31 +87,23 @@ TEST(CsvDialects, ImpossibleTimesAndDatesOutsideTAreLocatedErrors) {
 }
 
 TEST(CsvDialects, SemicolonSeparatorIsDetectedAndTakesDecimalCommas) {
-  const Recording rec = read_ok("t;u1;y1\n0;1,5;-2.25\n1;;nan\n", "semicolon");
-  ASSERT_EQ(rec.names, (std::vector<std::string>{"t", "u1", "y1"}));
-  EXPECT_EQ(rec.data(0, 1), 1.5);
-  EXPECT_EQ(rec.data(0, 2), -2.25);
-  EXPECT_TRUE(std::isnan(rec.data(1, 1)));
+  expect_table(read_ok("t;u1;y1\n0;1,5;-2.25\n1;;nan\n", "semicolon"), {"t", "u1", "y1"},
+               {{0, 1.5, -2.25}, {1, kNaN, kNaN}});
   // A comma is not a separator there: a row split by commas has too few fields.
   const std::string e = read_error("t;u1;y1\n0,1,2\n", "semicolon_commas");
   EXPECT_NE(e.find("semicolon_commas.csv:2: expected 3 fields (as in the header), got 1"), std::string::npos) << e;
 }
 
 TEST(CsvDialects, Rfc4180QuotesAreStrippedAndDoubledQuotesUnescaped) {
-  const Recording rec = read_ok("\"t\",\"u1\",\"y \"\"hot\"\", C\"\n\"0\",\"1.5\", \"2\" \n1,,\"\"\n", "quoted");
-  ASSERT_EQ(rec.names, (std::vector<std::string>{"t", "u1", "y \"hot\", C"}));
-  EXPECT_EQ(rec.data(0, 1), 1.5);
-  EXPECT_EQ(rec.data(0, 2), 2.0);
-  EXPECT_TRUE(std::isnan(rec.data(1, 2)));
+  expect_table(read_ok("\"t\",\"u1\",\"y \"\"hot\"\", C\"\n\"0\",\"1.5\", \"2\" \n1,,\"\"\n", "quoted"),
+               {"t", "u1", "y \"hot\", C"}, {{0, 1.5, 2.0}, {1, kNaN, kNaN}});
   // A quoted name with ';' inside does not make the file ';'-separated.
   EXPECT_EQ(read_ok("t,\"a;b\",u1\n0,1,2\n", "quoted_semicolon").names[1], "a;b");
 }
 
 TEST(CsvDialects, BomCrlfAndQuotesTogether) {
-  const Recording rec = read_ok("\xEF\xBB\xBF\"t\";\"u1\";\"y1\"\r\n2026-11-25T08:00:00Z;\"3,25\";4\r\n", "bom_crlf");
-  ASSERT_EQ(rec.names[0], "t");
-  EXPECT_EQ(rec.data(0, 0), k20261125T08);
-  EXPECT_EQ(rec.data(0, 1), 3.25);
+  expect_table(read_ok("\xEF\xBB\xBF\"t\";\"u1\";\"y1\"\r\n2026-11-25T08:00:00Z;\"3,25\";4\r\n", "bom_crlf"),
+               {"t", "u1", "y1"}, {{k20261125T08, 3.25, 4.0}});
 }
 
 TEST(CsvDialects, OtherDialectsAreRefusedByName) {

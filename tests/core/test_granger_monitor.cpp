@@ -59,13 +59,7 @@ std::vector<std::optional<std::vector<double>>> wood_berry_noise(int order) {
           inverse_noise_ar_coefficients(DiscreteTf{{1}, {1, -0.9}, 0}, order)};
 }
 
-MonitorSettings test_settings() {
-  MonitorSettings s;
-  s.ar_order = 5;
-  s.input_order = 6;
-  s.forgetting = 0.998;
-  return s;
-}
+MonitorSettings test_settings() { return {.ar_order = 5, .input_order = 6, .forgetting = 0.998}; }
 
 TEST(GrangerMonitor, NoMismatchRaisesNothing) {
   PlantedRun run(1);

@@ -37,6 +37,19 @@ msg::Status reference(const std::string& config, const std::vector<msg::Sample>&
 
 class CheckpointTest : public LoopbackTest {
  protected:
+  // Every test starts with the first mpmd up, checkpointing.
+  void SetUp() override {
+    LoopbackTest::SetUp();
+    if (HasFatalFailure()) return;
+    run = open_session(config_with_checkpoint(), "wb", 0, "first");
+    ASSERT_TRUE(run.up) << run.log();
+  }
+
+  // Publishes `n` samples of `c` (synced), keeping a copy of each in `sent`.
+  bool publish(Controller& c, int n, std::vector<msg::Sample>& sent) const {
+    return publish_synced(*run.t, *run.obs, c, n, 50, &sent);
+  }
+
   // mpmd.yaml with a checkpoint every 0.1 s; `plant` replaces the Wood-Berry file.
   std::string config_with_checkpoint(const std::string& plant = "") const {
     const std::string path = write_config("mpmd.yaml", "wb");
@@ -47,20 +60,6 @@ class CheckpointTest : public LoopbackTest {
     }
     dir().write("mpmd.yaml", text + "checkpoint_path: " + dir().file("mpmd.state") + "\ncheckpoint_interval: 0.1\n");
     return path;
-  }
-
-  // Publishes `n` samples of `c` (synced), keeping a copy of each.
-  bool publish(transport::Transport& t, Observer& obs, Controller& c, int n, std::vector<msg::Sample>& sent) {
-    for (int k = 0; k < n; ++k) {
-      sent.push_back(c.next());
-      if (!t.publish(c.sample)) return false;
-      ++c.sent;
-      if ((k + 1) % 50 == 0 || k + 1 == n) {
-        const std::int64_t seq = c.seq;
-        if (!obs.wait_status(c.id, [seq](const msg::Status& s) { return s.samples_seen >= seq; })) return false;
-      }
-    }
-    return true;
   }
 
   // The samples seen by the last checkpoint on disk (0 when none can be read).
@@ -76,6 +75,8 @@ class CheckpointTest : public LoopbackTest {
     }
     return service->counters().seen;
   }
+
+  Session run;  // the first mpmd, opened by SetUp
 };
 
 // Now, as a status's utime counts: a status made after it comes from a
@@ -87,18 +88,16 @@ std::int64_t unix_micros() {
 bool restarted(const msg::Status& s, std::int64_t after) { return s.utime >= after; }
 
 TEST_P(CheckpointTest, SigkillMidRunResumesTheStatisticsAndTheAlarm) {
-  Session run = open_session(config_with_checkpoint(), "wb", 0, "first");
-  ASSERT_TRUE(run.up) << run.log();
   Controller c("wb", 21);
   std::vector<msg::Sample> sent;
 
   // Matched, then G21 x 1.5 until u1 -> y2 is raised and a checkpoint holds it.
-  ASSERT_TRUE(publish(*run.t, *run.obs, c, 600, sent));
+  ASSERT_TRUE(publish(c, 600, sent));
   c.stream.set_g21_gain(1.5);
-  for (int k = 0; k < 30 && run.obs->alarms().empty(); ++k) ASSERT_TRUE(publish(*run.t, *run.obs, c, 50, sent));
+  for (int k = 0; k < 30 && run.obs->alarms().empty(); ++k) ASSERT_TRUE(publish(c, 50, sent));
   ASSERT_TRUE(run.obs->wait_alarms([](const auto& a) { return !a.empty(); }, std::chrono::seconds(10)));
   const auto raised_at = static_cast<std::uint64_t>(run.obs->alarms().front().sample_sequence);
-  ASSERT_TRUE(publish(*run.t, *run.obs, c, 200, sent));
+  ASSERT_TRUE(publish(c, 200, sent));
   ASSERT_TRUE(eventually([&] { return checkpointed(run.config) > raised_at; })) << run.mpmd->stderr_text();
 
   // More samples in flight, then SIGKILL: what came after the last checkpoint is lost.
@@ -139,7 +138,7 @@ TEST_P(CheckpointTest, SigkillMidRunResumesTheStatisticsAndTheAlarm) {
   }
   c.sample = sent.back();
   ASSERT_TRUE(sync(*run.obs, c));
-  ASSERT_TRUE(publish(*run.t, *run.obs, c, 300, sent));
+  ASSERT_TRUE(publish(c, 300, sent));
   const msg::Status end = *run.obs->status("wb");
   const double at_end = compare_status(end, reference(run.config, sent, sent.size()));
   EXPECT_LE(at_end, 1e-12);
@@ -155,11 +154,9 @@ TEST_P(CheckpointTest, SigkillMidRunResumesTheStatisticsAndTheAlarm) {
 }
 
 TEST_P(CheckpointTest, AChangedPlantOrADamagedFileStartsFresh) {
-  Session run = open_session(config_with_checkpoint(), "wb", 0, "first");
-  ASSERT_TRUE(run.up) << run.log();
   Controller c("wb", 22);
   std::vector<msg::Sample> sent;
-  ASSERT_TRUE(publish(*run.t, *run.obs, c, 300, sent));
+  ASSERT_TRUE(publish(c, 300, sent));
   run.mpmd->signal(SIGTERM);
   ASSERT_EQ(run.mpmd->wait_exit(std::chrono::seconds(20)), 0);
   ASSERT_EQ(checkpointed(run.config), 300u);

@@ -131,9 +131,13 @@ class LoopbackTest : public ::testing::TestWithParam<transport::Kind> {
   // Publishes `n` samples, `chunk` at a time, after each chunk waiting until
   // the daemon's status shows it has seen them: no sample is lost to a full
   // socket buffer on a slow machine, and the test never sleeps blindly.
-  static bool publish_synced(transport::Transport& t, Observer& obs, Controller& c, int n, int chunk = 50) {
+  // With a `log`, a copy of each sample is appended to it.
+  static bool publish_synced(transport::Transport& t, Observer& obs, Controller& c, int n, int chunk = 50,
+                             std::vector<msg::Sample>* log = nullptr) {
     for (int k = 0; k < n; ++k) {
-      if (!t.publish(c.next())) return false;
+      const msg::Sample& sample = c.next();
+      if (log != nullptr) log->push_back(sample);
+      if (!t.publish(sample)) return false;
       ++c.sent;
       if ((k + 1) % chunk == 0 || k + 1 == n) {
         if (!sync(obs, c)) return false;

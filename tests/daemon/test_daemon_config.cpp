@@ -6,7 +6,10 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <utility>
 #include <variant>
+#include <vector>
 
 #include "child_process.hpp"
 #include "config/daemon_config.hpp"
@@ -14,6 +17,7 @@
 #include "config/setting_text.hpp"
 #include "config/settings_doc.hpp"
 #include "config/plant_loader.hpp"
+#include "support/mentions.hpp"
 
 namespace mpm {
 namespace {
@@ -30,6 +34,12 @@ std::string error_of(const std::string& yaml) {
     return e.what();
   }
   return "";
+}
+
+// Config files, each with what its error must mention.
+using ErrorCases = std::vector<std::pair<std::string, std::vector<std::string>>>;
+void expect_errors(const ErrorCases& cases) {
+  for (const auto& [yaml, fragments] : cases) EXPECT_TRUE(test::mentions(error_of(yaml), fragments)) << yaml;
 }
 
 TEST(DaemonConfig, MinimalFileTakesTheDefaults) {
@@ -91,43 +101,19 @@ TEST(DaemonConfig, EverySettingIsRead) {
 
 TEST(DaemonConfig, ErrorsNameFileLineKeyAndExpectation) {
   const std::string head = "controller_id: wb\nplant: wood-berry.yaml\n";
-  std::string e = error_of(head + "monitor:\n  forgeting: 0.99\n");
-  EXPECT_NE(e.find("mpmd.yaml:4:"), std::string::npos) << e;
-  EXPECT_NE(e.find("monitor.forgeting"), std::string::npos) << e;
-  EXPECT_NE(e.find("unknown key"), std::string::npos) << e;
-
-  e = error_of(head + "monitor:\n  forgetting: 1.5\n");
-  EXPECT_NE(e.find("mpmd.yaml:4:"), std::string::npos) << e;
-  EXPECT_NE(e.find("monitor.forgetting"), std::string::npos) << e;
-  EXPECT_NE(e.find("forgetting must be in (0.9, 1]"), std::string::npos) << e;
-
-  e = error_of(head + "transport: {kind: zeromq}\n");
-  EXPECT_NE(e.find("transport.kind"), std::string::npos) << e;
-  EXPECT_NE(e.find("expected lcm or dds"), std::string::npos) << e;
-
-  e = error_of(head + "monitor: {ar_order: ten}\n");
-  EXPECT_NE(e.find("monitor.ar_order"), std::string::npos) << e;
-  EXPECT_NE(e.find("expected an integer"), std::string::npos) << e;
-
-  e = error_of("plant: wood-berry.yaml\n");
-  EXPECT_NE(e.find("controller_id"), std::string::npos) << e;
-
-  e = error_of("controller_id: wb\nplant: no-such-plant.yaml\n");
-  EXPECT_NE(e.find("mpmd.yaml:2:"), std::string::npos) << e;
-  EXPECT_NE(e.find("no such plant file"), std::string::npos) << e;
-
-  e = error_of(head + "transport: {dds: {config: missing.xml}}\n");
-  EXPECT_NE(e.find("transport.dds.config"), std::string::npos) << e;
-
-  e = error_of(head + "transport: {dds: {domain: 300}}\n");
-  EXPECT_NE(e.find("0..230"), std::string::npos) << e;
-
-  e = error_of(head + "status_period: 0\n");
-  EXPECT_NE(e.find("status_period"), std::string::npos) << e;
-
-  e = error_of("controller_id: [unclosed\n");
-  EXPECT_NE(e.find("mpmd.yaml:"), std::string::npos) << e;
-  EXPECT_NE(e.find("invalid YAML"), std::string::npos) << e;
+  expect_errors({
+      {head + "monitor:\n  forgeting: 0.99\n", {"mpmd.yaml:4:", "monitor.forgeting", "unknown key"}},
+      {head + "monitor:\n  forgetting: 1.5\n",
+       {"mpmd.yaml:4:", "monitor.forgetting", "forgetting must be in (0.9, 1]"}},
+      {head + "transport: {kind: zeromq}\n", {"transport.kind", "expected lcm or dds"}},
+      {head + "monitor: {ar_order: ten}\n", {"monitor.ar_order", "expected an integer"}},
+      {"plant: wood-berry.yaml\n", {"controller_id"}},
+      {"controller_id: wb\nplant: no-such-plant.yaml\n", {"mpmd.yaml:2:", "no such plant file"}},
+      {head + "transport: {dds: {config: missing.xml}}\n", {"transport.dds.config"}},
+      {head + "transport: {dds: {domain: 300}}\n", {"0..230"}},
+      {head + "status_period: 0\n", {"status_period"}},
+      {"controller_id: [unclosed\n", {"mpmd.yaml:", "invalid YAML"}},
+  });
 }
 
 // Validation returns {field, message}: a caller points at the key by its
@@ -279,24 +265,15 @@ TEST(DaemonConfig, LimitsSectionSetsTheLoadersCaps) {
     config::load_plant(low.plant_path, low.limits);
     ADD_FAILURE() << "a delay of 8 passed a cap of 4";
   } catch (const ConfigError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("wood-berry.yaml:"), std::string::npos) << what;
-    EXPECT_NE(what.find("delay"), std::string::npos) << what;
-    EXPECT_NE(what.find("0..4"), std::string::npos) << what;
+    EXPECT_TRUE(test::mentions(e.what(), {"wood-berry.yaml:", "delay", "0..4"}));
   }
 
-  std::string e = error_of(head + "limits:\n  max_inputs: 0\n");
-  EXPECT_NE(e.find("mpmd.yaml:4:"), std::string::npos) << e;
-  EXPECT_NE(e.find("limits.max_inputs"), std::string::npos) << e;
-  EXPECT_NE(e.find("1..10000"), std::string::npos) << e;
-  e = error_of(head + "limits:\n  max_delay_samples: 2.5\n");
-  EXPECT_NE(e.find("limits.max_delay_samples"), std::string::npos) << e;
-  EXPECT_NE(e.find("whole number"), std::string::npos) << e;
-  e = error_of(head + "limits:\n  max_pizza: 3\n");
-  EXPECT_NE(e.find("mpmd.yaml:4:"), std::string::npos) << e;
-  EXPECT_NE(e.find("no cap named max_pizza"), std::string::npos) << e;
-  e = error_of(head + "limits: [1, 2]\n");
-  EXPECT_NE(e.find("limits"), std::string::npos) << e;
+  expect_errors({
+      {head + "limits:\n  max_inputs: 0\n", {"mpmd.yaml:4:", "limits.max_inputs", "1..10000"}},
+      {head + "limits:\n  max_delay_samples: 2.5\n", {"limits.max_delay_samples", "whole number"}},
+      {head + "limits:\n  max_pizza: 3\n", {"mpmd.yaml:4:", "no cap named max_pizza"}},
+      {head + "limits: [1, 2]\n", {"limits"}},
+  });
 }
 
 TEST(Mpmd, InvalidConfigAtStartIsOneClearErrorAndExitOne) {

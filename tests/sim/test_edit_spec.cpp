@@ -13,9 +13,12 @@
 #include "sim/edit_spec.hpp"
 #include "sim/scenarios.hpp"
 #include "sim/sim_test_support.hpp"
+#include "support/mentions.hpp"
 
 namespace mpm::sim {
 namespace {
+
+using test::mentions;
 
 const std::vector<std::string> kInputs{"u1", "u2"}, kOutputs{"y1", "y2"};
 
@@ -140,27 +143,18 @@ TEST(EditSpec, NamesWithDotsAreSplitOnTheNames) {
 }
 
 TEST(EditSpec, UnknownNamesAreNamedWithTheSpec) {
-  std::string m = parse_error("y3.u1.gain=2");
-  EXPECT_NE(m.find("'y3.u1.gain=2'"), std::string::npos) << m;
-  EXPECT_NE(m.find("unknown output 'y3'"), std::string::npos) << m;
-  EXPECT_NE(m.find("y1, y2"), std::string::npos) << m;
-  m = parse_error("y2.u9.gain=2");
-  EXPECT_NE(m.find("unknown input 'u9'"), std::string::npos) << m;
-  m = parse_error("u3.actuator_lag=0.5");
-  EXPECT_NE(m.find("unknown input 'u3'"), std::string::npos) << m;
-  m = parse_error("y1.actuator_lag=0.5");  // an output where an input belongs
-  EXPECT_NE(m.find("unknown input 'y1'"), std::string::npos) << m;
-  m = parse_error("u1.sensor_lag=0.5");
-  EXPECT_NE(m.find("unknown output 'u1'"), std::string::npos) << m;
-  m = parse_error("y1.gain=2");  // a channel key needs both names
-  EXPECT_NE(m.find("OUTPUT.INPUT"), std::string::npos) << m;
+  EXPECT_TRUE(mentions(parse_error("y3.u1.gain=2"), {"'y3.u1.gain=2'", "unknown output 'y3'", "y1, y2"}));
+  EXPECT_TRUE(mentions(parse_error("y2.u9.gain=2"), {"unknown input 'u9'"}));
+  EXPECT_TRUE(mentions(parse_error("u3.actuator_lag=0.5"), {"unknown input 'u3'"}));
+  // An output where an input belongs, and an input where an output does.
+  EXPECT_TRUE(mentions(parse_error("y1.actuator_lag=0.5"), {"unknown input 'y1'"}));
+  EXPECT_TRUE(mentions(parse_error("u1.sensor_lag=0.5"), {"unknown output 'u1'"}));
+  EXPECT_TRUE(mentions(parse_error("y1.gain=2"), {"OUTPUT.INPUT"}));  // a channel key needs both names
 }
 
 TEST(EditSpec, UnknownKeysAndMalformedSpecsAreRefused) {
-  std::string m = parse_error("y2.u1.gian=2");
-  EXPECT_NE(m.find("'y2.u1.gian=2'"), std::string::npos) << m;
-  EXPECT_NE(m.find("unknown key 'gian'"), std::string::npos) << m;
-  EXPECT_NE(m.find("time_constant"), std::string::npos) << m;  // lists the keys
+  // The key named, and the keys there are listed.
+  EXPECT_TRUE(mentions(parse_error("y2.u1.gian=2"), {"'y2.u1.gian=2'", "unknown key 'gian'", "time_constant"}));
   for (const char* bad : {"", "gain=2", ".gain=2", "y2u1gain", "=1"})
     EXPECT_NE(parse_error(bad).find("expected OUTPUT.INPUT.KEY=VALUE"), std::string::npos) << bad;
   EXPECT_NE(parse_error("y2.u1.gain").find("needs a value"), std::string::npos);
@@ -202,16 +196,13 @@ TEST(EditSpec, OutOfRangeValuesAreRefused) {
 }
 
 TEST(EditSpec, ConflictsFoundWhenApplying) {
-  std::string m = error_of([] { applied({"y2.u1.gain=2", "y2.u1.gain=3"}); });
-  EXPECT_NE(m.find("'y2.u1.gain=3'"), std::string::npos) << m;
-  EXPECT_NE(m.find("already given by 'y2.u1.gain=2'"), std::string::npos) << m;
-  m = error_of([] { applied({"u1.lower=0", "u1.upper=0"}); });
-  EXPECT_NE(m.find("'u1.upper=0'"), std::string::npos) << m;
-  EXPECT_NE(m.find("lower_limit must be below upper_limit"), std::string::npos) << m;
+  EXPECT_TRUE(mentions(error_of([] { applied({"y2.u1.gain=2", "y2.u1.gain=3"}); }),
+                       {"'y2.u1.gain=3'", "already given by 'y2.u1.gain=2'"}));
+  EXPECT_TRUE(mentions(error_of([] { applied({"u1.lower=0", "u1.upper=0"}); }),
+                       {"'u1.upper=0'", "lower_limit must be below upper_limit"}));
   PlantSpec tank;
   tank.kind = ProcessKind::quad_tank;
-  m = error_of([&] { applied({"y1.u1.gain=2"}, tank); });
-  EXPECT_NE(m.find("quadruple tank takes no channel edits"), std::string::npos) << m;
+  EXPECT_TRUE(mentions(error_of([&] { applied({"y1.u1.gain=2"}, tank); }), {"quadruple tank takes no channel edits"}));
   EXPECT_EQ(applied({"y1.sensor_lag=0.3"}, tank).outputs.size(), 1u);  // its transmitters may be edited
 }
 

@@ -1,5 +1,6 @@
-// Helpers for tests that drive the built `mpm` binary: where it is, a
-// temporary file name, running a command quietly, reading a file whole.
+// Helpers for tests that drive the built `mpm` binary: where it and the
+// plant files are, a temporary file name, running a command quietly,
+// reading a file whole.
 #pragma once
 
 #include <sys/wait.h>
@@ -14,6 +15,9 @@
 namespace mpm::test {
 
 inline const std::string kMpm = std::string(MPM_BINARY_DIR) + "/daemon/mpm";
+
+// A plant file of the source tree's config/ folder.
+inline std::string config_file(const std::string& name) { return std::string(MPM_SOURCE_DIR) + "/config/" + name; }
 
 // A path in the test's temporary folder, `prefix` + `name`.
 inline std::string tmp_path(const std::string& prefix, const std::string& name) {
