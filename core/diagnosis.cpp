@@ -139,7 +139,8 @@ std::string describe(const Context& cx, const Candidate& c, double family, doubl
   for (const auto& ch : c.finding.channels)
     m += p.outputs[ch.output] + "<-" + (ch.input ? p.inputs[*ch.input] : c.finding.signal.value_or("-")) + " ";
   return m + "] lr " + fmt(c.lr, 4) + " (limit " + fmt(fit_limit(cx.settings, family, c.params), 3) +
-         ", pooled with z_hold^2 " + fmt(pooled_limit(cx.settings, family, c.params), 3) + ") z_hold " + fmt(c.z_hold, 3) +
+         ", pooled with z_hold^2 " + fmt(pooled_limit(cx.settings, family, c.params), 3) + ") z_hold " +
+         fmt(c.z_hold, 3) + " (expected " + fmt(c.z_expected, 3) + ")" +
          " beyond_noise " + fmt(c.lr_beyond_noise, 4) + " bic " + fmt(c.bic(log_n), 4) + " selection " + fmt(selection_score(cx, c, log_n), 4) + ": " +
          c.finding.summary;
 }

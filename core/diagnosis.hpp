@@ -67,6 +67,10 @@ struct Settings {
   double alpha = 1e-3;          // family-wise false-alarm level of accepting a hypothesis
   double holdout_level = 0.05;  // level of the held-out confirmation (holdout_z is its quantile)
   double holdout_z = 1.645;     // one-sided 5 % paired test on the held-out part
+  // Below this expected z (what an exact correction would give on the
+  // held-out part) the held-out test is uninformative and the fit-part test
+  // decides alone (passes() in diagnosis_score.cpp).
+  double holdout_informative_z = 1.0;
   // Level of the test that a process candidate explains the residual beyond
   // a changed disturbance model (the gate of score()): it chooses between two
   // explanations of a mismatch the family-wise test has already found, so it

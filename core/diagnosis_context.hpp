@@ -94,6 +94,7 @@ struct Candidate {
   int params = 0;
   double lr = 0.0;        // sum over outputs of n_fit ln(before / after), whitened
   double z_hold = 0.0;    // projection test on the held-out part
+  double z_expected = 0.0;  // what z_hold would be on average were the correction exactly right
   double hold_gain = 0.0; // sum over outputs of ln(before / after), held-out whitened variance
   // The hypothesis fitted jointly with an AR(3) change of the disturbance
   // model, against that change alone: what it explains beyond a wrong N.
@@ -157,10 +158,12 @@ void refresh(Context& cx, std::size_t j);
 // gate; its selection score (BIC on the fit part plus the held-out
 // log-likelihood gain); the fit block of its finding (and the raw one).
 double fit_level(const Settings& s, double family);
-// The fit-part limit of a candidate with `params` parameters, and the limit
-// of its pooled statistic lr + z_hold^2 (see passes()).
+// The fit-part limit of a candidate with `params` parameters (with the
+// held-out test), and the limit of its pooled statistic lr + z_hold^2.
 double fit_limit(const Settings& s, double family, int params);
 double pooled_limit(const Settings& s, double family, int params);
+// The fit-part limit where the held-out part is uninformative (see passes()).
+double uninformed_limit(const Settings& s, double family, int params);
 bool passes(const Candidate& c, const Settings& s, double family);
 double selection_score(const Context& cx, const Candidate& c, double log_n);
 FitNumbers fit_numbers(const Context& cx, const Candidate& c, FitNumbers& raw);

@@ -166,7 +166,7 @@ TEST(DiagnoseCli, MissingChannelIsNamedAndNoFindingRespondsWithinTheSample) {
 // own on these records (seeds of the randomised benchmark): the changed
 // disturbance model, a candidate beside them, explains more and is named.
 TEST(DiagnoseCli, ChangedDisturbancesAreNotTakenForAProcessChange) {
-  const std::string model = read_file(std::string(MPM_SOURCE_DIR) + "/config/three-by-three.yaml");
+  const std::string model = read_file(config_file("three-by-three.yaml"));
   for (const auto& [output, pole, seed] : {std::tuple{"y2", "0.709", 37903}, std::tuple{"y3", "0.97", 72016}}) {
     const std::string anchor = std::string("  - output: ") + output + "\n    num: [1]\n    den: [1, -";
     const std::size_t at = model.find(anchor);
@@ -178,11 +178,10 @@ TEST(DiagnoseCli, ChangedDisturbancesAreNotTakenForAProcessChange) {
       f << model.substr(0, from) << pole << model.substr(end);
     }
     const std::string csv = tmp_path("noise.csv"), out = tmp_path("noise.json");
-    ASSERT_EQ(run(kMpm + " simulate --scenario plant-nominal --plant " + changed +
+    ASSERT_EQ(run_quietly(kMpm + " simulate --scenario plant-nominal --plant " + changed +
                   " --move-weight-scale 0.001 --seed " + std::to_string(seed) + " --out " + csv),
               0);
-    ASSERT_EQ(run(kMpm + " diagnose --quiet --plant " + std::string(MPM_SOURCE_DIR) +
-                  "/config/three-by-three.yaml --data " + csv + " --json " + out),
+    ASSERT_EQ(run_quietly(kMpm + " diagnose --quiet --plant " + config_file("three-by-three.yaml") + " --data " + csv + " --json " + out),
               0);
     const std::string r = read_file(out);
     EXPECT_EQ(physics_words(r), std::set<std::string>{"disturbance_model"}) << output << " seed " << seed << ":\n" << r;
