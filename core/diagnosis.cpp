@@ -141,8 +141,8 @@ std::string describe(const Context& cx, const Candidate& c, double family, doubl
   return m + "] lr " + fmt(c.lr, 4) + " (limit " + fmt(fit_limit(cx.settings, family, c.params), 3) +
          ", pooled with z_hold^2 " + fmt(pooled_limit(cx.settings, family, c.params), 3) + ") z_hold " +
          fmt(c.z_hold, 3) + " (expected " + fmt(c.z_expected, 3) + ")" +
-         " beyond_noise " + fmt(c.lr_beyond_noise, 4) + " bic " + fmt(c.bic(log_n), 4) + " selection " + fmt(selection_score(cx, c, log_n), 4) + ": " +
-         c.finding.summary;
+         " beyond_noise " + fmt(c.lr_beyond_noise, 4) + " bic " + fmt(c.bic(log_n), 4) + " selection " +
+         fmt(selection_score(cx, c, log_n), 4) + ": " + c.finding.summary;
 }
 
 // Takes the chosen candidate's correction out of its outputs' residuals: a
@@ -151,9 +151,9 @@ std::string describe(const Context& cx, const Candidate& c, double family, doubl
 // candidates on that output are fitted and tested under the new noise model).
 void accept(Context& cx, const Candidate& chosen) {
   if (chosen.whitener_change) {
-    OutputState& o = cx.out[chosen.fits.at(0).output];
-    o.whitener = series(*chosen.whitener_change, o.whitener);
-    refresh(cx, chosen.fits[0].output);
+    const std::size_t j = chosen.fits.at(0).output;
+    cx.out[j].whitener = series(*chosen.whitener_change, cx.out[j].whitener);
+    refresh(cx, j);
     return;
   }
   for (const auto& of : chosen.fits) {
