@@ -99,13 +99,9 @@ std::vector<Candidate> generate(const Context& cx, const std::set<std::pair<std:
   for (std::size_t j = 0; j < cx.n_out(); ++j)
     for (std::size_t i = 0; i < cx.n_in(); ++i)
       if (!used.count({j, static_cast<long>(i)})) add(Scope::channel, {.output = j, .input = i});
-  groups.flush(all, cx.settings.threads);
-  if (progress) progress("channel hypotheses fitted");
   for (std::size_t i = 0; i < cx.n_in(); ++i) add(Scope::column, {.input = i});
   for (std::size_t j = 0; j < cx.n_out(); ++j) add(Scope::row, {.output = j});
   add(Scope::plant, {});
-  groups.flush(all, cx.settings.threads);
-  if (progress) progress("column and row hypotheses fitted");
   // A loose screen (5 %, plain lags have little power on slow responses):
   // the decision is the structured fit's own test below, Bonferroni-corrected.
   const double pre = chi_square_quantile_upper(0.05, cx.settings.input_lags);
@@ -120,12 +116,14 @@ std::vector<Candidate> generate(const Context& cx, const std::set<std::pair<std:
                   fmt(lr, 4) + " (limit " + fmt(pre, 3) + ")").c_str());
       if (lr > pre) add(Scope::signal, {.output = j, .column = column});
     }
-  groups.flush(all, cx.settings.threads);
   // A changed disturbance model of each output, once per output: the
   // process changes above compete with it for the same residual.
   for (std::size_t j = 0; j < cx.n_out(); ++j)
     if (!noise_changed[j]) add(Scope::noise, {.output = j});
+  // One flush for the round: a barrier between scopes would leave a thread
+  // idle while the other finishes the scope's slowest group.
   groups.flush(all, cx.settings.threads);
+  if (progress) progress("hypotheses fitted");
   std::vector<Candidate> keep;
   for (auto& c : all)
     if (!overlaps(used, c.finding)) keep.push_back(std::move(c));

@@ -83,6 +83,10 @@ struct OutputFit {
   LinearFit fit;    // whitened; theta holds the hypothesis' own coefficients only
   Vec fixed;                    // the hypothesis' fixed correction c0 (may be empty)
   std::vector<Vec> regressors;  // the hypothesis' linear regressors X (raw)
+  // The fit's whitened target and regressors, kept until the candidate is
+  // scored: the test beyond a changed noise model refits on them.
+  Vec whitened_target;                // empty: the output's own (wd, or wbase with signals)
+  std::vector<Vec> whitened_regressors;
   Vec signal_theta;             // the accepted signals' coefficients in the joint fit
 };
 
@@ -112,6 +116,11 @@ struct Candidate {
 
 // Drops a scored candidate's N-long columns; its numbers stay.
 void release_series(Candidate& c);
+// Drops a fit's whitened columns (once scored, nothing reads them).
+void release_whitened(OutputFit& f);
+// The fit-part error variance of f refitted with an AR(3) change of the
+// disturbance model beside it (the test beyond a changed noise model).
+double beyond_noise_fit_var(const Context& cx, const OutputFit& f);
 // Whether make_candidate keeps c's columns (Context::keep_series, rebuilding).
 bool keeps_series(const Context& cx, const Candidate& c);
 
@@ -127,6 +136,11 @@ double objective(const Context& cx, const std::vector<OutputFit>& fits);
 // fit's N-long columns are not copied into a vector for every point of a
 // search.
 double objective(const Context& cx, const OutputFit& fit);
+// What objective(cx, {fit_output(cx, j, c0, X)}) gives, from the columns
+// already whitened (wc0 = whitener c0, may be null; wx = whitener X): for
+// searches that form them in fewer filter passes (filters in series, or a
+// lag of a whitened column, the whitener being linear and at rest at 0).
+double whitened_objective(const Context& cx, std::size_t j, const Vec* wc0, const std::vector<const Vec*>& wx);
 // Fills lr, z_hold, hold_gain and lr_beyond_noise.
 void score(const Context& cx, Candidate& c);
 // Regressors of a change of output j's disturbance model given residual r:

@@ -51,9 +51,12 @@ void fit_dead_time(const Context& cx, const Hypothesis& h, const Site& site, std
   // fits than a short one.
   const int shortest = std::max({-g.delay, cx.min_input_delay - cx.response_delay(j, i),
                                  -cx.settings.max_extra_delay});
+  // The delay and the whitener commute: the search shifts the whitened column.
+  const Vec wx = simulate(cx.out[j].whitener, x);
   for (int s = shortest; s <= cx.settings.max_extra_delay; ++s) {
     if (s == 0) continue;
-    const double o = objective(cx, {fit_output(cx, j, shifted(x, s) - x, {})});
+    const Vec wc0 = shifted(wx, s) - wx;
+    const double o = whitened_objective(cx, j, &wc0, {});
     if (o < best_obj) {
       best_obj = o;
       best = s;
@@ -76,13 +79,21 @@ void fit_time_constant(const Context& cx, const Hypothesis& h, const Site& s, st
   const Vec& x = cx.gu[j * cx.n_in() + i];
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
   const double tau = tau_of(p);
-  auto corr = [&](double log_ratio) {
+  const auto moved = [&](double log_ratio) {
     const double p2 = std::exp(-1.0 / (tau * std::exp(log_ratio)));
-    return Vec(simulate(move_pole(g, p, p2, (1.0 - p2) / (1.0 - p)), u) - x);
+    return move_pole(g, p, p2, (1.0 - p2) / (1.0 - p));
+  };
+  auto corr = [&](double log_ratio) { return Vec(simulate(moved(log_ratio), u) - x); };
+  // The search whitens in series with the moved channel: one pass a point.
+  const DiscreteTf& whitener = cx.out[j].whitener;
+  const Vec wx = simulate(whitener, x);
+  const auto search = [&](double log_ratio) {
+    const Vec wc0 = simulate(series(whitener, moved(log_ratio)), u) - wx;
+    return whitened_objective(cx, j, &wc0, {});
   };
   std::vector<double> grid;
   for (int k = 0; k <= 16; ++k) grid.push_back(std::log(0.25) + k * (std::log(4.0) - std::log(0.25)) / 16.0);
-  const double lr = minimise_on_grid(grid, [&](double v) { return objective(cx, {fit_output(cx, j, corr(v), {})}); });
+  const double lr = minimise_on_grid(grid, search);
   const double p2 = std::exp(-1.0 / (tau * std::exp(lr)));
   Candidate c = make_candidate(cx, h, {{j, i}}, {fit_output(cx, j, corr(lr), {})});
   c.finding.nominal = g;
@@ -99,7 +110,12 @@ void fit_extra_lag(const Context& cx, const Hypothesis& h, const Site& s, std::v
   const double tau_nom = std::max(2.0, tau_of(slowest_pole(g)));
   const auto grid = lag_pole_grid(0.3, tau_nom, 16);
   auto corr = [&](double a) { return Vec(simulate(unit_lag(a), x) - x); };
-  const double a = minimise_on_grid(grid, [&](double v) { return objective(cx, {fit_output(cx, j, corr(v), {})}); });
+  // The lag and the whitener commute: the search lags the whitened column.
+  const Vec wx = simulate(cx.out[j].whitener, x);
+  const double a = minimise_on_grid(grid, [&](double v) {
+    const Vec wc0 = simulate(unit_lag(v), wx) - wx;
+    return whitened_objective(cx, j, &wc0, {});
+  });
   if (a <= 0.0) return;
   Candidate c = make_candidate(cx, h, {{j, i}}, {fit_output(cx, j, corr(a), {})});
   c.finding.nominal = g;
@@ -151,10 +167,14 @@ Fopdt best_fopdt(const Context& cx, std::size_t j, const Vec& x, int min_delay, 
   double best_obj = std::numeric_limits<double>::infinity();
   std::vector<double> poles{0.0};
   for (double a : lag_pole_grid(0.5, 200.0, 14)) poles.push_back(a);
+  // The lag, the delay and the whitener commute: each pole lags the
+  // whitened input once, and each delay shifts that.
+  const Vec wx = simulate(cx.out[j].whitener, x);
   for (double a : poles) {
-    const Vec lagged = simulate(unit_lag(a), x);
+    const Vec lagged = simulate(unit_lag(a), wx);
     for (int d = min_delay; d <= max_delay; ++d) {
-      const double o = objective(cx, {fit_output(cx, j, Vec(), {shifted(lagged, d)})});
+      const Vec regressor = shifted(lagged, d);
+      const double o = whitened_objective(cx, j, nullptr, {&regressor});
       if (o < best_obj) {
         best_obj = o;
         best = {a, d};
@@ -167,7 +187,8 @@ Fopdt best_fopdt(const Context& cx, std::size_t j, const Vec& x, int min_delay, 
   for (int k = -4; k <= 4; ++k) fine.push_back(std::exp(-1.0 / (t0 * std::pow(1.35, k))));
   if (best.pole == 0.0) fine.insert(fine.begin(), 0.0);
   best.pole = minimise_on_grid(fine, [&](double a) {
-    return objective(cx, {fit_output(cx, j, Vec(), {shifted(simulate(unit_lag(a), x), best.delay)})});
+    const Vec regressor = shifted(simulate(unit_lag(a), wx), best.delay);
+    return whitened_objective(cx, j, nullptr, {&regressor});
   });
   return best;
 }

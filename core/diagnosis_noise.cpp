@@ -26,8 +26,15 @@ void fit_disturbance_model(const Context& cx, const Hypothesis& h, const Site& s
   };
   std::vector<double> poles;
   for (int k = -6; k <= 14; ++k) poles.push_back(k < 0 ? 0.15 * k : 1.0 - std::pow(0.7, k + 1));
+  // The ARMA(1,1) residual is (1 - a q^-1) v with v = wd / (1 - b q^-1):
+  // the search forms it from v, one filter pass per point.
   const double b = minimise_on_grid(poles, [&](double v) {
-    return least_squares(simulate(arma(v), o.wd), {}, cx.seg).fit_var;
+    const Vec filtered = simulate(DiscreteTf{{1.0}, {1.0, -v}, 0}, o.wd);
+    const double a = -fit_ar(filtered, cx.seg.fit, 1)[1];
+    Vec e(filtered.size());
+    if (e.size()) e(0) = filtered(0);
+    for (Index k = 1; k < e.size(); ++k) e(k) = filtered(k) - a * filtered(k - 1);
+    return least_squares(e, {}, cx.seg).fit_var;
   });
   corrections.push_back(arma(b));
   const double limit_alpha = fit_level(cx.settings, static_cast<double>(corrections.size() * cx.n_out()));

@@ -47,15 +47,30 @@ std::vector<OutputFit> input_change_fits(const Context& cx, std::size_t i, const
   return fits;
 }
 
+// The objective of those corrections, as the searches need it: one filter
+// pass per output (the channel and the output's whitener in series) and no
+// raw columns. The same number as objective(cx, input_change_fits(...)) up
+// to rounding.
+double input_change_objective(const Context& cx, std::size_t i, const std::vector<std::size_t>& js, const Vec& v) {
+  const Vec delta = v - cx.problem.du.col(static_cast<Index>(i));
+  double sum = 0.0;
+  for (std::size_t j : js) {
+    const Vec wc0 = simulate(series(cx.out[j].whitener, *cx.channel(j, i)), delta);
+    sum += whitened_objective(cx, j, &wc0, {});
+  }
+  return sum;
+}
+
 }  // namespace
 
 void fit_actuator(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
   const std::size_t i = s.input;
   const auto js = column_outputs(cx, i);
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
-  auto fits = [&](double a) { return input_change_fits(cx, i, js, simulate(unit_lag(a), u)); };
-  const double a = minimise_on_grid(lag_pole_grid(0.3, 30.0, 16), [&](double v) { return objective(cx, fits(v)); });
-  Candidate c = make_candidate(cx, h, column_channels(js, i), fits(a));
+  const auto lagged = [&](double a) { return simulate(unit_lag(a), u); };
+  const double a = minimise_on_grid(lag_pole_grid(0.3, 30.0, 16),
+                                    [&](double v) { return input_change_objective(cx, i, js, lagged(v)); });
+  Candidate c = make_candidate(cx, h, column_channels(js, i), input_change_fits(cx, i, js, lagged(a)));
   c.finding.nominal = *cx.channel(js[0], i);
   c.finding.fitted = series(*cx.channel(js[0], i), unit_lag(a));
   c.finding.parameters["actuator_lag_pole"] = a;
@@ -80,7 +95,7 @@ void fit_saturation(const Context& cx, const Hypothesis& h, const Site& s, std::
     auto f = [&](double q) {
       const double lim = quantile(std::clamp(q, 0.0, 1.0));
       const Vec v = side == 0 ? clipped(u, -1e300, lim) : clipped(u, lim, 1e300);
-      return objective(cx, input_change_fits(cx, i, js, v));
+      return input_change_objective(cx, i, js, v);
     };
     const double q = minimise_on_grid(grid, f);
     const double o = f(q);
@@ -107,9 +122,10 @@ void fit_deadband(const Context& cx, const Hypothesis& h, const Site& s, std::ve
   const double scale = std::max(1e-12, moves.mean());
   std::vector<double> grid;
   for (int k = 0; k <= 14; ++k) grid.push_back(std::log(0.05 * scale) + k * std::log(200.0) / 14.0);
-  auto fits = [&](double lw) { return input_change_fits(cx, i, js, backlash(u, std::exp(lw))); };
-  const double lw = minimise_on_grid(grid, [&](double v) { return objective(cx, fits(v)); });
-  Candidate c = make_candidate(cx, h, column_channels(js, i), fits(lw));
+  const auto played = [&](double lw) { return backlash(u, std::exp(lw)); };
+  const double lw =
+      minimise_on_grid(grid, [&](double v) { return input_change_objective(cx, i, js, played(v)); });
+  Candidate c = make_candidate(cx, h, column_channels(js, i), input_change_fits(cx, i, js, played(lw)));
   c.finding.nominal = *cx.channel(js[0], i);
   c.finding.fitted = *cx.channel(js[0], i);
   c.finding.parameters["backlash_width"] = std::exp(lw);
@@ -253,13 +269,16 @@ void fit_sensor(const Context& cx, const Hypothesis& h, const Site& s, std::vect
   const OutputState& o = cx.out[j];
   const Vec& r = o.signals.empty() ? o.d : o.base;
   const Index n = r.size();
-  const auto fits = [&](double a) {
-    Vec c = Vec::Zero(n);
-    for (Index k = 1; k < n; ++k) c[k] = a * (r[k - 1] + total[k - 1] - total[k]);
-    return std::vector<OutputFit>{fit_output(cx, j, c, {})};
-  };
+  Vec step = Vec::Zero(n);  // c / a
+  for (Index k = 1; k < n; ++k) step[k] = r[k - 1] + total[k - 1] - total[k];
+  const auto fits = [&](double a) { return std::vector<OutputFit>{fit_output(cx, j, Vec(a * step), {})}; };
+  // c is linear in a: the search scales the whitened column.
+  const Vec wstep = simulate(o.whitener, step);
   const std::vector<double> grid = lag_pole_grid(0.3, 30.0, 16);
-  const double a = minimise_on_grid(grid, [&](double v) { return objective(cx, fits(v)); });
+  const double a = minimise_on_grid(grid, [&](double v) {
+    const Vec wc0 = v * wstep;
+    return whitened_objective(cx, j, &wc0, {});
+  });
   Candidate c = make_candidate(cx, h, cs, fits(a));
   c.finding.nominal = *cx.channel(j, cs[0].input.value());
   c.finding.fitted = series(*cx.channel(j, cs[0].input.value()), unit_lag(a));

@@ -36,8 +36,8 @@ OutputFit fit_output(const Context& cx, std::size_t j, Vec c0, std::vector<Vec> 
   if (joint)
     for (const Vec& s : o.wsignals) regs.push_back(&s);
   f.fit = least_squares_at(c0.size() ? wc0 : w0, regs, cx.seg);
-  wc0.resize(0);
-  wx.clear();
+  f.whitened_target = std::move(wc0);
+  f.whitened_regressors = std::move(wx);
   f.correction = c0.size() ? c0 : Vec::Zero(o.d.size());
   for (std::size_t l = 0; l < X.size(); ++l) f.correction += f.fit.theta(static_cast<Index>(l)) * X[l];
   f.fixed = std::move(c0);
@@ -60,7 +60,14 @@ void release_series(Candidate& c) {
     f.regressors.clear();
     f.regressors.shrink_to_fit();
     f.fit.hold_error.resize(0);
+    release_whitened(f);
   }
+}
+
+void release_whitened(OutputFit& f) {
+  f.whitened_target.resize(0);
+  f.whitened_regressors.clear();
+  f.whitened_regressors.shrink_to_fit();
 }
 
 bool keeps_series(const Context& cx, const Candidate& c) {
@@ -75,6 +82,18 @@ double objective(const Context& cx, const std::vector<OutputFit>& fits) {
   double s = 0.0;
   for (const auto& f : fits) s += std::log(f.fit.fit_var / cx.out[f.output].fit_var);
   return s * static_cast<double>(cx.seg.fit_samples());
+}
+
+double whitened_objective(const Context& cx, std::size_t j, const Vec* wc0, const std::vector<const Vec*>& wx) {
+  const OutputState& o = cx.out[j];
+  const bool joint = !o.signals.empty();
+  const Vec& w0 = joint ? o.wbase : o.wd;
+  std::vector<const Vec*> regs = wx;
+  if (joint)
+    for (const Vec& w : o.wsignals) regs.push_back(&w);
+  const double var = wc0 ? least_squares_at(Vec(w0 - *wc0), regs, cx.seg).fit_var
+                         : least_squares_at(w0, regs, cx.seg).fit_var;
+  return std::log(var / o.fit_var) * static_cast<double>(cx.seg.fit_samples());
 }
 
 double objective(const Context& cx, const OutputFit& fit) {
@@ -170,13 +189,32 @@ void score(const Context& cx, Candidate& c) {
   // take up the correction itself), a real process change still explains
   // the residual; one that rode on the wrong N does not.
   double beyond = 0.0;
-  for (const auto& f : c.fits) {
-    const OutputState& o = cx.out[f.output];
-    std::vector<Vec> X = f.regressors;
-    for (Vec& lag : noise_change_regressors(o.d - f.correction)) X.push_back(std::move(lag));
-    beyond += std::log(o.noise_change_var / fit_output(cx, f.output, f.fixed, X).fit.fit_var);
+  for (auto& f : c.fits) {
+    beyond += std::log(cx.out[f.output].noise_change_var / beyond_noise_fit_var(cx, f));
+    release_whitened(f);
   }
   c.lr_beyond_noise = beyond * static_cast<double>(cx.seg.fit_samples());
+}
+
+// The fit of f again with the lags of the residual it leaves as further
+// regressors, on the whitened columns f's own fit used. The whitener is
+// linear and starts at rest, so whitening a lagged residual is lagging the
+// whitened one: one filter pass instead of one per lag.
+double beyond_noise_fit_var(const Context& cx, const OutputFit& f) {
+  const OutputState& o = cx.out[f.output];
+  if (f.whitened_regressors.size() != f.regressors.size() || (f.fixed.size() && !f.whitened_target.size())) {
+    std::vector<Vec> X = f.regressors;
+    for (Vec& lag : noise_change_regressors(o.d - f.correction)) X.push_back(std::move(lag));
+    return fit_output(cx, f.output, f.fixed, X).fit.fit_var;
+  }
+  const std::vector<Vec> lags = noise_change_regressors(simulate(o.whitener, o.d - f.correction));
+  std::vector<const Vec*> regs;
+  for (const Vec& x : f.whitened_regressors) regs.push_back(&x);
+  for (const Vec& x : lags) regs.push_back(&x);
+  if (!o.signals.empty())
+    for (const Vec& s : o.wsignals) regs.push_back(&s);
+  const Vec& target = f.fixed.size() ? f.whitened_target : (o.signals.empty() ? o.wd : o.wbase);
+  return least_squares_at(target, regs, cx.seg).fit_var;
 }
 
 // The fit-part test and the held-out test are independent under "no

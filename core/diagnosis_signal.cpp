@@ -135,22 +135,37 @@ std::vector<double> deflate(const std::vector<double>& den, double p) {
 }
 
 std::vector<double> fit_ar(const Vec& x, const std::vector<char>& mask, int order) {
-  std::vector<Index> rows;
-  for (Index k = order; k < x.size(); ++k)
-    if (mask[static_cast<std::size_t>(k)]) rows.push_back(k);
   std::vector<double> a(static_cast<std::size_t>(order) + 1, 0.0);
   a[0] = 1.0;
-  if (static_cast<Index>(rows.size()) < 4 * (order + 1)) return a;
-  Eigen::MatrixXd X(static_cast<Index>(rows.size()), order + 1);
-  Vec y(static_cast<Index>(rows.size()));
-  for (std::size_t r = 0; r < rows.size(); ++r) {
-    const auto i = static_cast<Index>(r);
-    X(i, 0) = 1.0;
-    for (int l = 1; l <= order; ++l) X(i, l) = x(rows[r] - l);
-    y(i) = x(rows[r]);
+  // The rows: samples of the mask from `order` on, as runs of consecutive
+  // samples, so that every sum below is a vector pass over a run.
+  std::vector<std::pair<Index, Index>> runs;
+  Index rows = 0;
+  for (Index k = order; k < x.size(); ++k) {
+    if (!mask[static_cast<std::size_t>(k)]) continue;
+    if (runs.empty() || runs.back().second != k) runs.push_back({k, k});
+    runs.back().second = k + 1;
+    ++rows;
   }
-  const Vec beta = X.colPivHouseholderQr().solve(y);
-  for (int l = 1; l <= order; ++l) a[static_cast<std::size_t>(l)] = -beta(l);
+  if (rows < 4 * (order + 1)) return a;
+  // Normal equations on centred columns (the intercept), as least_squares_at
+  // solves them: the order is 1-3 and the lags of a whitened residual are
+  // well conditioned, so they lose nothing to a QR of the N x (order + 1)
+  // matrix and need no copy of it. Column l is x lagged by l (0: the target).
+  const auto column = [&](int l, Index first, Index end) { return x.segment(first - l, end - first); };
+  Vec mean = Vec::Zero(order + 1);
+  for (const auto& [first, end] : runs)
+    for (int l = 0; l <= order; ++l) mean(l) += column(l, first, end).sum();
+  mean /= static_cast<double>(rows);
+  Eigen::MatrixXd gram = Eigen::MatrixXd::Zero(order + 1, order + 1);
+  for (const auto& [first, end] : runs)
+    for (int l = 0; l <= order; ++l)
+      for (int m = 0; m <= l; ++m)
+        gram(l, m) += (column(l, first, end).array() - mean(l)).matrix().dot(
+            (column(m, first, end).array() - mean(m)).matrix());
+  const Eigen::MatrixXd lags = gram.bottomRightCorner(order, order).selfadjointView<Eigen::Lower>();
+  const Vec beta = lags.ldlt().solve(gram.col(0).tail(order));
+  for (int l = 1; l <= order; ++l) a[static_cast<std::size_t>(l)] = -beta(l - 1);
   return a;
 }
 
