@@ -137,10 +137,10 @@ double objective(const Context& cx, const std::vector<OutputFit>& fits);
 // search.
 double objective(const Context& cx, const OutputFit& fit);
 // What objective(cx, {fit_output(cx, j, c0, X)}) gives, from the columns
-// already whitened (wc0 = whitener c0, may be null; wx = whitener X): for
+// already whitened (wc0 = whitener c0, may be empty; wx = whitener X): for
 // searches that form them in fewer filter passes (filters in series, or a
 // lag of a whitened column, the whitener being linear and at rest at 0).
-double whitened_objective(const Context& cx, std::size_t j, const Vec* wc0, const std::vector<const Vec*>& wx);
+double whitened_objective(const Context& cx, std::size_t j, Vec wc0, const std::vector<const Vec*>& wx);
 // Fills lr, z_hold, hold_gain and lr_beyond_noise.
 void score(const Context& cx, Candidate& c);
 // Regressors of a change of output j's disturbance model given residual r:

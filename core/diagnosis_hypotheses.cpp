@@ -55,8 +55,8 @@ void fit_dead_time(const Context& cx, const Hypothesis& h, const Site& site, std
   const Vec wx = simulate(cx.out[j].whitener, x);
   for (int s = shortest; s <= cx.settings.max_extra_delay; ++s) {
     if (s == 0) continue;
-    const Vec wc0 = shifted(wx, s) - wx;
-    const double o = whitened_objective(cx, j, &wc0, {});
+    Vec wc0 = shifted(wx, s) - wx;
+    const double o = whitened_objective(cx, j, std::move(wc0), {});
     if (o < best_obj) {
       best_obj = o;
       best = s;
@@ -88,8 +88,8 @@ void fit_time_constant(const Context& cx, const Hypothesis& h, const Site& s, st
   const DiscreteTf& whitener = cx.out[j].whitener;
   const Vec wx = simulate(whitener, x);
   const auto search = [&](double log_ratio) {
-    const Vec wc0 = simulate(series(whitener, moved(log_ratio)), u) - wx;
-    return whitened_objective(cx, j, &wc0, {});
+    Vec wc0 = simulate(series(whitener, moved(log_ratio)), u) - wx;
+    return whitened_objective(cx, j, std::move(wc0), {});
   };
   std::vector<double> grid;
   for (int k = 0; k <= 16; ++k) grid.push_back(std::log(0.25) + k * (std::log(4.0) - std::log(0.25)) / 16.0);
@@ -113,8 +113,8 @@ void fit_extra_lag(const Context& cx, const Hypothesis& h, const Site& s, std::v
   // The lag and the whitener commute: the search lags the whitened column.
   const Vec wx = simulate(cx.out[j].whitener, x);
   const double a = minimise_on_grid(grid, [&](double v) {
-    const Vec wc0 = simulate(unit_lag(v), wx) - wx;
-    return whitened_objective(cx, j, &wc0, {});
+    Vec wc0 = simulate(unit_lag(v), wx) - wx;
+    return whitened_objective(cx, j, std::move(wc0), {});
   });
   if (a <= 0.0) return;
   Candidate c = make_candidate(cx, h, {{j, i}}, {fit_output(cx, j, corr(a), {})});
@@ -174,7 +174,7 @@ Fopdt best_fopdt(const Context& cx, std::size_t j, const Vec& x, int min_delay, 
     const Vec lagged = simulate(unit_lag(a), wx);
     for (int d = min_delay; d <= max_delay; ++d) {
       const Vec regressor = shifted(lagged, d);
-      const double o = whitened_objective(cx, j, nullptr, {&regressor});
+      const double o = whitened_objective(cx, j, Vec(), {&regressor});
       if (o < best_obj) {
         best_obj = o;
         best = {a, d};
@@ -188,7 +188,7 @@ Fopdt best_fopdt(const Context& cx, std::size_t j, const Vec& x, int min_delay, 
   if (best.pole == 0.0) fine.insert(fine.begin(), 0.0);
   best.pole = minimise_on_grid(fine, [&](double a) {
     const Vec regressor = shifted(simulate(unit_lag(a), wx), best.delay);
-    return whitened_objective(cx, j, nullptr, {&regressor});
+    return whitened_objective(cx, j, Vec(), {&regressor});
   });
   return best;
 }

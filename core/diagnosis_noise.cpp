@@ -34,7 +34,7 @@ void fit_disturbance_model(const Context& cx, const Hypothesis& h, const Site& s
     Vec e(filtered.size());
     if (e.size()) e(0) = filtered(0);
     for (Index k = 1; k < e.size(); ++k) e(k) = filtered(k) - a * filtered(k - 1);
-    return least_squares(e, {}, cx.seg).fit_var;
+    return least_squares(e, {}, cx.seg, Part::fit).fit_var;
   });
   corrections.push_back(arma(b));
   const double limit_alpha = fit_level(cx.settings, static_cast<double>(corrections.size() * cx.n_out()));

@@ -55,8 +55,8 @@ double input_change_objective(const Context& cx, std::size_t i, const std::vecto
   const Vec delta = v - cx.problem.du.col(static_cast<Index>(i));
   double sum = 0.0;
   for (std::size_t j : js) {
-    const Vec wc0 = simulate(series(cx.out[j].whitener, *cx.channel(j, i)), delta);
-    sum += whitened_objective(cx, j, &wc0, {});
+    Vec wc0 = simulate(series(cx.out[j].whitener, *cx.channel(j, i)), delta);
+    sum += whitened_objective(cx, j, std::move(wc0), {});
   }
   return sum;
 }
@@ -276,8 +276,8 @@ void fit_sensor(const Context& cx, const Hypothesis& h, const Site& s, std::vect
   const Vec wstep = simulate(o.whitener, step);
   const std::vector<double> grid = lag_pole_grid(0.3, 30.0, 16);
   const double a = minimise_on_grid(grid, [&](double v) {
-    const Vec wc0 = v * wstep;
-    return whitened_objective(cx, j, &wc0, {});
+    Vec wc0 = v * wstep;
+    return whitened_objective(cx, j, std::move(wc0), {});
   });
   Candidate c = make_candidate(cx, h, cs, fits(a));
   c.finding.nominal = *cx.channel(j, cs[0].input.value());

@@ -84,15 +84,15 @@ double objective(const Context& cx, const std::vector<OutputFit>& fits) {
   return s * static_cast<double>(cx.seg.fit_samples());
 }
 
-double whitened_objective(const Context& cx, std::size_t j, const Vec* wc0, const std::vector<const Vec*>& wx) {
+double whitened_objective(const Context& cx, std::size_t j, Vec wc0, const std::vector<const Vec*>& wx) {
   const OutputState& o = cx.out[j];
   const bool joint = !o.signals.empty();
   const Vec& w0 = joint ? o.wbase : o.wd;
   std::vector<const Vec*> regs = wx;
   if (joint)
     for (const Vec& w : o.wsignals) regs.push_back(&w);
-  const double var = wc0 ? least_squares_at(Vec(w0 - *wc0), regs, cx.seg).fit_var
-                         : least_squares_at(w0, regs, cx.seg).fit_var;
+  if (wc0.size()) wc0 = w0 - wc0;  // coefficient-wise, in place
+  const double var = least_squares_at(wc0.size() ? wc0 : w0, regs, cx.seg, Part::fit).fit_var;
   return std::log(var / o.fit_var) * static_cast<double>(cx.seg.fit_samples());
 }
 
@@ -214,7 +214,7 @@ double beyond_noise_fit_var(const Context& cx, const OutputFit& f) {
   if (!o.signals.empty())
     for (const Vec& s : o.wsignals) regs.push_back(&s);
   const Vec& target = f.fixed.size() ? f.whitened_target : (o.signals.empty() ? o.wd : o.wbase);
-  return least_squares_at(target, regs, cx.seg).fit_var;
+  return least_squares_at(target, regs, cx.seg, Part::fit).fit_var;
 }
 
 // The fit-part test and the held-out test are independent under "no

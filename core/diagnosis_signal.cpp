@@ -209,14 +209,15 @@ void Segments::index() {
   indexed = true;
 }
 
-LinearFit least_squares(const Vec& target, const std::vector<Vec>& regressors, const Segments& seg) {
+LinearFit least_squares(const Vec& target, const std::vector<Vec>& regressors, const Segments& seg, Part part) {
   std::vector<const Vec*> cols;
   cols.reserve(regressors.size());
   for (const Vec& x : regressors) cols.push_back(&x);
-  return least_squares_at(target, cols, seg);
+  return least_squares_at(target, cols, seg, part);
 }
 
-LinearFit least_squares_at(const Vec& target, const std::vector<const Vec*>& regressors, const Segments& seg) {
+LinearFit least_squares_at(const Vec& target, const std::vector<const Vec*>& regressors, const Segments& seg,
+                           Part part) {
   Segments local;
   if (!seg.indexed) {
     local.fit_runs = runs_of(seg.fit, seg.begin);
@@ -276,6 +277,7 @@ LinearFit least_squares_at(const Vec& target, const std::vector<const Vec*>& reg
     }
   out.fit_var = std::max(1e-300, s2 / static_cast<double>(n) - (s / static_cast<double>(n)) * (s / static_cast<double>(n)));
   if (p > 0) out.theta_se *= std::sqrt(out.fit_var);
+  if (part == Part::fit) return out;
   out.hold_error = Vec::Zero(target.size());
   double h = 0.0, h2 = 0.0;
   Index nh = 0;

@@ -75,9 +75,14 @@ struct LinearFit {
   double hold_var = 0.0;   // error variance on the held-out part (about its own mean)
   Vec hold_error;          // full length: mean-removed errors on held-out samples, 0 elsewhere
 };
-LinearFit least_squares(const Vec& target, const std::vector<Vec>& regressors, const Segments& seg);
+// Part::fit: the fit part only (theta and fit_var; no held-out errors), for
+// the objective of a search.
+enum class Part { fit, fit_and_holdout };
+LinearFit least_squares(const Vec& target, const std::vector<Vec>& regressors, const Segments& seg,
+                        Part part = Part::fit_and_holdout);
 // The same on regressors held elsewhere (no copies of N-long columns).
-LinearFit least_squares_at(const Vec& target, const std::vector<const Vec*>& regressors, const Segments& seg);
+LinearFit least_squares_at(const Vec& target, const std::vector<const Vec*>& regressors, const Segments& seg,
+                           Part part = Part::fit_and_holdout);
 
 // Minimises f over a grid and refines the best point by golden section
 // between its neighbours. Returns the argument.
