@@ -182,9 +182,6 @@ bool passes(const Candidate& c, const Settings& s, double family);
 double selection_score(const Context& cx, const Candidate& c, double log_n);
 FitNumbers fit_numbers(const Context& cx, const Candidate& c, FitNumbers& raw);
 
-// Granger test of extra column `column` on output j's residual, given the
-// inputs: likelihood ratio (chi-square with `dof`).
-double signal_granger_lr(const Context& cx, std::size_t j, std::size_t column, int& dof);
 
 // Pole grid for lags: time constants log-spaced in [tau_lo, tau_hi] samples.
 std::vector<double> lag_pole_grid(double tau_lo, double tau_hi, int points);

@@ -105,24 +105,6 @@ std::vector<LagBlock> input_blocks(const Context& cx, std::size_t j, int nb) {
 
 }  // namespace
 
-double signal_granger_lr(const Context& cx, std::size_t j, std::size_t column, int& dof) {
-  const int nb = cx.settings.input_lags;
-  std::vector<LagBlock> blocks = input_blocks(cx, j, nb);
-  // Plain lags of the inputs with no channel (a missing channel).
-  std::vector<Vec> plain;
-  plain.reserve(cx.n_in());
-  for (std::size_t i = 0; i < cx.n_in(); ++i)
-    if (cx.excited[i] && !cx.gu[j * cx.n_in() + i].size()) plain.push_back(cx.problem.du.col(static_cast<Index>(i)));
-  for (const Vec& p : plain) blocks.push_back({&p, 1, nb});
-  const Arx without = arx(cx, cx.out[j].d, cx.settings.ar_order, blocks);
-  const Vec z = cx.extra.col(static_cast<Index>(column));
-  blocks.push_back({&z, 0, nb});
-  const Arx with = arx(cx, cx.out[j].d, cx.settings.ar_order, blocks);
-  dof = nb;
-  if (with.rows == 0 || with.rss <= 0.0) return 0.0;
-  return static_cast<double>(with.rows) * std::log(without.rss / with.rss);
-}
-
 Context prepare(const Problem& p, const Settings& s) {
   Context cx{p, s, {}, {}, {}, {}, {}, {}};
   const Index n = p.residual.rows();
