@@ -218,6 +218,27 @@ std::vector<std::string> alternatives(const Context& cx, const Candidate& best, 
   return out;
 }
 
+// A gain on every channel of a column is taken only where, on each of its
+// channels, the channel's own gain is as good an explanation as the best
+// other form there (within the alias margin): otherwise a strong lag on one
+// channel would be named a gain because a strong gain rides on another.
+bool column_gains_consistent(const Context& cx, const Candidate& c, const std::vector<Candidate>& cands,
+                             double log_n) {
+  if (c.hypothesis->physics != Physics::gain || c.hypothesis->scope != Scope::column) return true;
+  for (const Channel& ch : c.finding.channels) {
+    double gain = -std::numeric_limits<double>::infinity(), other = gain;
+    for (const Candidate& o : cands) {
+      if (o.hypothesis->scope != Scope::channel || o.finding.channels.size() != 1 ||
+          o.finding.channels[0].output != ch.output || o.finding.channels[0].input != ch.input)
+        continue;
+      double& slot = o.hypothesis->physics == Physics::gain ? gain : other;
+      slot = std::max(slot, selection_score(cx, o, log_n));
+    }
+    if (gain < other - std::max(kAliasAbsolute, kAliasRelative * std::abs(other))) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 Result diagnose(const Problem& problem, const Settings& settings, Progress progress) {
@@ -252,7 +273,9 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
     double best_score = -std::numeric_limits<double>::infinity();
     for (const auto& c : cands) {
       if (settings.verbose && progress) progress(describe(cx, c, family, log_n).c_str());
-      if (!passes(c, settings, family) || (signal_first && !c.finding.signal)) continue;
+      if (!passes(c, settings, family) || (signal_first && !c.finding.signal) ||
+          !column_gains_consistent(cx, c, cands, log_n))
+        continue;
       const double score_c = selection_score(cx, c, log_n);
       if (score_c > best_score) {
         best_score = score_c;

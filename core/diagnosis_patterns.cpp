@@ -63,6 +63,45 @@ double input_change_objective(const Context& cx, std::size_t i, const std::vecto
 
 }  // namespace
 
+// Gains changed on every channel of one input, each by its own factor (a
+// valve whose split drifted, a feed whose composition changed): one finding,
+// one factor per channel, so that a channel too weak to pass alone is named
+// with the strong one it moves with. The selection takes it only where the
+// gain is, on each of its channels, as good an explanation as any other
+// form (column_gains_consistent in diagnosis.cpp).
+void fit_column_gains(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
+  const std::size_t i = s.input;
+  // The outputs' fits are independent, so the subset of channels with the
+  // best BIC is those whose own gain pays its parameter (LR above ln n): a
+  // channel that did not change is left out, not carried along by the others.
+  const double log_n = std::log(static_cast<double>(cx.seg.fit_samples()));
+  std::vector<std::size_t> js;
+  std::vector<OutputFit> fits;
+  for (std::size_t j : column_outputs(cx, i)) {
+    OutputFit f = fit_output(cx, j, Vec(), {cx.gu[j * cx.n_in() + i]});
+    if (-objective(cx, f) <= log_n) continue;
+    js.push_back(j);
+    fits.push_back(std::move(f));
+  }
+  if (js.size() < 2) return;
+  std::vector<double> factors, ses;
+  for (const OutputFit& f : fits) {
+    factors.push_back(1.0 + f.fit.theta(0));
+    ses.push_back(f.fit.theta_se(0));
+  }
+  Candidate c = make_candidate(cx, h, column_channels(js, i), std::move(fits));
+  c.finding.nominal = *cx.channel(js[0], i);
+  DiscreteTf fitted = *cx.channel(js[0], i);
+  for (double& b : fitted.num) b *= factors[0];
+  c.finding.fitted = fitted;
+  for (std::size_t r = 0; r < js.size(); ++r) {
+    const std::string suffix = "_" + cx.problem.outputs[js[r]];
+    c.finding.parameters["gain_factor" + suffix] = factors[r];
+    c.facts["gain_factor_se" + suffix] = ses[r];
+  }
+  out.push_back(std::move(c));
+}
+
 void fit_actuator(const Context& cx, const Hypothesis& h, const Site& s, std::vector<Candidate>& out) {
   const std::size_t i = s.input;
   const auto js = column_outputs(cx, i);

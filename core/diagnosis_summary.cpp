@@ -24,6 +24,17 @@ std::string say_gain(const Problem& p, const Finding& f, const Facts& x) {
          fmt(k + 1.96 * se) + ")";
 }
 
+std::string say_column_gains(const Problem& p, const Finding& f, const Facts& x) {
+  std::string m = "gains of " + p.inputs[*f.channels[0].input] + " changed:";
+  for (std::size_t r = 0; r < f.channels.size(); ++r) {
+    const std::string& out = p.outputs[f.channels[r].output];
+    const double k = param(f, "gain_factor_" + out), se = fact(x, "gain_factor_se_" + out);
+    m += std::string(r ? "," : "") + " -> " + out + " " + fmt(k) + " x nominal (95% CI " + fmt(k - 1.96 * se) + "-" +
+         fmt(k + 1.96 * se) + ")";
+  }
+  return m;
+}
+
 std::string say_dead_time(const Problem& p, const Finding& f, const Facts&) {
   return "dead time of " + arrow(p, f) + " is " + std::to_string(f.fitted->delay) + " samples (" +
          fmt(f.fitted->delay * p.sample_time) + " s), nominal " + std::to_string(f.nominal->delay);

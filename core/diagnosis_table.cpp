@@ -46,7 +46,7 @@ using G = Gate;
 
 // In generation order within each scope: the order breaks ties between
 // candidates of equal selection score.
-const std::array<Hypothesis, 16> kTable{{
+const std::array<Hypothesis, 17> kTable{{
     {P::gain, S::channel, 1, Per::finding, G::beyond_noise, modelled_channel, fit_gain, say_gain},
     {P::dead_time, S::channel, 1, Per::finding, G::beyond_noise, modelled_channel, fit_dead_time, say_dead_time},
     {P::time_constant, S::channel, 1, Per::finding, G::beyond_noise, slow_mode, fit_time_constant,
@@ -59,6 +59,8 @@ const std::array<Hypothesis, 16> kTable{{
     {P::missing_channel, S::channel, 3, Per::finding, G::beyond_noise, unmodelled_channel, fit_missing_channel,
      say_missing_channel},
     {P::actuator_dynamics, S::column, 1, Per::finding, G::beyond_noise, shared_column, fit_actuator, say_actuator},
+    // one gain factor per channel of the input
+    {P::gain, S::column, 1, Per::channel, G::beyond_noise, shared_column, fit_column_gains, say_column_gains},
     {P::saturation, S::column, 1, Per::finding, G::beyond_noise, any_column, fit_saturation, say_saturation},
     {P::deadband, S::column, 1, Per::finding, G::beyond_noise, any_column, fit_deadband, say_deadband},
     // linear, even, odd term per channel, on the column and (of two or more) on

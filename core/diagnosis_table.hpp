@@ -80,6 +80,7 @@ void fit_extra_lag(const Context&, const Hypothesis&, const Site&, std::vector<C
 void fit_integrator(const Context&, const Hypothesis&, const Site&, std::vector<Candidate>&);
 void fit_missing_channel(const Context&, const Hypothesis&, const Site&, std::vector<Candidate>&);
 void fit_actuator(const Context&, const Hypothesis&, const Site&, std::vector<Candidate>&);
+void fit_column_gains(const Context&, const Hypothesis&, const Site&, std::vector<Candidate>&);
 void fit_saturation(const Context&, const Hypothesis&, const Site&, std::vector<Candidate>&);
 void fit_deadband(const Context&, const Hypothesis&, const Site&, std::vector<Candidate>&);
 void fit_static_map(const Context&, const Hypothesis&, const Site&, std::vector<Candidate>&);
@@ -98,6 +99,7 @@ std::string say_extra_lag(const Problem&, const Finding&, const Facts&);
 std::string say_integrator(const Problem&, const Finding&, const Facts&);
 std::string say_missing_channel(const Problem&, const Finding&, const Facts&);
 std::string say_actuator(const Problem&, const Finding&, const Facts&);
+std::string say_column_gains(const Problem&, const Finding&, const Facts&);
 std::string say_saturation(const Problem&, const Finding&, const Facts&);
 std::string say_deadband(const Problem&, const Finding&, const Facts&);
 std::string say_static_map(const Problem&, const Finding&, const Facts&);

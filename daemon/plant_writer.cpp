@@ -116,7 +116,10 @@ void apply_channel(CorrectedPlant& c, const diagnosis::Finding& f, const diagnos
   const bool first = c.why[k].empty();
   if (first) c.why[k].push_back(was(m));
   if (is(f, Physics::gain)) {
-    const double g = param(f, "gain_factor", 1.0);
+    // One factor per channel where the finding spans a column (gain_factor_<output>).
+    const std::string key =
+        f.channels.size() == 1 ? std::string("gain_factor") : "gain_factor_" + c.plant.outputs[ch.output];
+    const double g = param(f, key.c_str(), 1.0);
     for (double& b : m.tf.num) b *= g;
     if (m.continuous)
       for (double& b : m.continuous->num) b *= g;
@@ -165,6 +168,9 @@ CorrectedPlant apply_findings(const PlantModel& plant, const diagnosis::Result& 
     const bool one_channel = f.channels.size() == 1 && f.channels[0].input.has_value();
     if (is_channel_physics(f) && one_channel && f.fitted) {
       apply_channel(c, f, f.channels[0]);
+    } else if (is(f, Physics::gain) && f.fitted) {
+      for (const auto& ch : f.channels)
+        if (ch.input) apply_channel(c, f, ch);
     } else if (is(f, Physics::actuator_dynamics) && f.parameters.count("actuator_lag_pole")) {
       apply_series_lag(c, f, f.parameters.at("actuator_lag_pole"));
     } else if (is(f, Physics::sensor_dynamics) && f.parameters.count("sensor_lag_pole")) {

@@ -188,6 +188,32 @@ TEST(DiagnoseCli, ChangedDisturbancesAreNotTakenForAProcessChange) {
   }
 }
 
+// Gains changed on both channels of one input are one finding with a factor
+// per channel (the weaker channel alone would not pass the family-wise
+// test); a gain on one channel beside an extra lag on the other stays a gain
+// and a lag: a column's gains are not taken where another form explains a
+// channel better.
+TEST(DiagnoseCli, GainsOnOneInputAreOneFindingButNotOverALag) {
+  const auto diagnose_edits = [](const std::string& name, const std::string& edits, int seed) {
+    const std::string csv = tmp_path(name + ".csv"), out = tmp_path(name + ".json");
+    EXPECT_EQ(run_quietly(kMpm + " simulate --scenario wood-berry-nominal --seed " + std::to_string(seed) + " " +
+                          edits + " --out " + csv),
+              0);
+    EXPECT_EQ(run_quietly(kMpm + " diagnose --quiet --plant " + kWoodBerry + " --data " + csv + " --json " + out), 0);
+    return read_file(out);
+  };
+  for (int seed : {3, 4}) {
+    const std::string gains = diagnose_edits("column-gains", "--edit y1.u1.gain=1.3 --edit y2.u1.gain=0.85", seed);
+    EXPECT_EQ(physics_words(gains), std::set<std::string>{"gain"}) << "seed " << seed << ":\n" << gains;
+    EXPECT_NE(gains.find("\"gain_factor_y1\""), std::string::npos) << gains;
+    EXPECT_NE(gains.find("\"gain_factor_y2\""), std::string::npos) << gains;
+    const std::string mixed = diagnose_edits("gain-and-lag", "--edit y1.u1.gain=1.3 --edit y2.u1.lag=0.6", seed);
+    EXPECT_EQ(physics_words(mixed), (std::set<std::string>{"gain", "unmodeled_dynamics"})) << "seed " << seed
+                                                                                          << ":\n" << mixed;
+    EXPECT_EQ(mixed.find("gain_factor_y2"), std::string::npos) << mixed;
+  }
+}
+
 // The paper's 4x4 case 4.2.4: G32, a fast channel (tau 0.11 s at a 2 s
 // sample time, so no slow pole to move to 1), gains an integrator and the
 // loop diverges. The plant is the channel followed by an integrator.

@@ -98,6 +98,26 @@ TEST(WritePlant, ComposesFindingsAndReadsBack) {
   ASSERT_TRUE(back.operating_point.has_value() == nominal.operating_point.has_value());
 }
 
+// A gain finding over a column carries one factor per channel
+// (gain_factor_<output>): each channel is scaled by its own.
+TEST(WritePlant, ColumnGainsScaleEachChannelByItsOwnFactor) {
+  const mpm::PlantModel nominal = mpm::config::load_plant(kWoodBerry);
+  mpm::diagnosis::Result r;
+  r.mismatch = true;
+  auto gains = finding("gain", {{0, 0}, {1, 0}}, {{"gain_factor_y1", 1.3}, {"gain_factor_y2", 0.8}});
+  gains.fitted = channel(nominal, 0, 0).tf;
+  r.findings.push_back(gains);
+  const mpm::CorrectedPlant c = mpm::apply_findings(nominal, r);
+  EXPECT_EQ(c.changes, 1u);
+  EXPECT_TRUE(c.not_applied.empty());
+  for (const auto& [j, factor] : {std::pair{std::size_t{0}, 1.3}, std::pair{std::size_t{1}, 0.8}}) {
+    mpm::DiscreteTf expected = channel(nominal, j, 0).tf;
+    for (double& b : expected.num) b *= factor;
+    expect_tf_near(channel(c.plant, j, 0).tf, expected);
+  }
+  expect_tf_near(channel(c.plant, 0, 1).tf, channel(nominal, 0, 1).tf);  // the other input's untouched
+}
+
 // A fit flagged implausible (a channel whose sign the fit reversed) is held
 // back: the file says so and the channel keeps its nominal model.
 TEST(WritePlant, AnImplausibleFindingIsHeldBack) {
