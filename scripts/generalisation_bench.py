@@ -410,6 +410,10 @@ def score(results):
     conf = defaultdict(Counter)
     tp = fp = fn = 0
     det = det_n = fa = fa_n = right = n_true = errors = 0
+    # The runs where mpm found a mismatch at all: the randomised magnitudes
+    # include effects below any test's reach (concealed and too weak), and
+    # the word can only be judged where something was detected.
+    detected_true = detected_right = 0
     by_plant = defaultdict(Counter)  # per plant kind (random / fixed): physics right, true findings
     for r in results:
         if "error" in r:
@@ -447,6 +451,9 @@ def score(results):
             kind = "random" if r["plant"] == "rand" else "fixed"
             by_plant[kind]["true_findings"] += 1
             by_plant[kind]["physics_right"] += got == t["physics"]
+            if r["mismatch"]:
+                detected_true += 1
+                detected_right += got == t["physics"]
     prec = tp / (tp + fp) if tp + fp else 1.0
     rec = tp / (tp + fn) if tp + fn else 1.0
     f1 = 2 * prec * rec / (prec + rec) if prec + rec else 0.0
@@ -454,6 +461,7 @@ def score(results):
             "nominal_runs": fa_n, "physics_right": right, "true_findings": n_true, "locate_precision": round(prec, 3),
             "locate_recall": round(rec, 3), "locate_f1": round(f1, 3),
             "by_plant": {k: dict(v) for k, v in by_plant.items()},
+            "detected_true_findings": detected_true, "detected_physics_right": detected_right,
             "confusion": {k: dict(v) for k, v in conf.items()}}
 
 
@@ -472,6 +480,10 @@ def print_matrix(s):
           % (s["runs"], s["errors"], s["detect"], s["mismatch_runs"], s["false_alarms"], s["nominal_runs"],
              s["physics_right"], s["true_findings"], 100.0 * s["physics_right"] / max(1, s["true_findings"]),
              s["locate_precision"], s["locate_recall"], s["locate_f1"]))
+    if "detected_true_findings" in s:
+        print("  physics where a mismatch was detected: %d/%d (%.0f %%)" % (
+            s["detected_physics_right"], s["detected_true_findings"],
+            100.0 * s["detected_physics_right"] / max(1, s["detected_true_findings"])))
     print("  physics by plant: " + ", ".join("%s %d/%d" % (k, v.get("physics_right", 0), v.get("true_findings", 0))
                                             for k, v in sorted(s.get("by_plant", {}).items())))
 
