@@ -189,24 +189,30 @@ Finding monitor_fallback(const Context& cx, std::size_t j) {
 constexpr double kAliasAbsolute = 3.84;
 constexpr double kAliasRelative = 0.03;
 
-// The words the data cannot tell from the chosen candidate: other words on
-// the same channels (and signal) that pass every test and score within the
-// margin, best first, each once. The chosen word is not changed.
+// Whether two findings speak of the same place: a channel in common, or one
+// output where either has no input (a changed disturbance model beside a
+// sensor lag or a channel's change on that output).
+bool same_place(const Finding& a, const Finding& b) {
+  for (const auto& x : a.channels)
+    for (const auto& y : b.channels)
+      if (x.output == y.output && (x.input == y.input || !x.input || !y.input)) return true;
+  return false;
+}
+
+// The words the data cannot tell from the chosen candidate: other words at
+// the same place (and signal) that pass every test and score within the
+// margin, best first, each once: an actuator lag beside one channel's extra
+// lag where the column's other channels carry too little to tell, a sensor
+// lag beside a changed disturbance model where the process part carries
+// little of it. The chosen word is not changed.
 std::vector<std::string> alternatives(const Context& cx, const Candidate& best, const std::vector<Candidate>& cands,
                                       double family, double log_n) {
-  const auto key = [](const Finding& f) {
-    std::vector<std::pair<std::size_t, long>> k;
-    for (const auto& c : f.channels) k.push_back({c.output, c.input ? static_cast<long>(*c.input) : -1});
-    std::sort(k.begin(), k.end());
-    return k;
-  };
-  const auto chans = key(best.finding);
   const double top = selection_score(cx, best, log_n);
   const double margin = std::max(kAliasAbsolute, kAliasRelative * std::abs(top));
   std::vector<std::pair<double, std::string>> near;
   for (const auto& c : cands) {
     if (c.finding.physics == best.finding.physics || c.finding.signal != best.finding.signal ||
-        key(c.finding) != chans || !passes(c, cx.settings, family))
+        !same_place(c.finding, best.finding) || !passes(c, cx.settings, family))
       continue;
     const double score_c = selection_score(cx, c, log_n);
     if (top - score_c <= margin) near.push_back({score_c, c.finding.physics});
