@@ -189,9 +189,9 @@ Context prepare(const Problem& p, const Settings& s) {
       // And each recorded signal through each of the output's channels, as
       // the inputs are: a signal that enters with an input (a heater's
       // disturbance) acts through a channel far slower than its plain lags
-      // reach, and without these columns the AR part took its effect for
-      // the noise's and whitened it away (a TCLab heater disturbance of 20 %,
-      // 13 degrees on T1, came out at LR 1).
+      // reach: without these columns the AR part is fitted with the
+      // signal's slow response unexplained, and on the real TCLab runs a
+      // heater disturbance of 20 % (13 degrees on T1) came out at LR 1.
       std::vector<Vec> through;
       through.reserve(extras.size() * cx.n_in());
       for (const Vec& z : extras)
