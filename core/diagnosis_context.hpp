@@ -116,11 +116,6 @@ struct Candidate {
 
 // Drops a scored candidate's N-long columns; its numbers stay.
 void release_series(Candidate& c);
-// Drops a fit's whitened columns (once scored, nothing reads them).
-void release_whitened(OutputFit& f);
-// The fit-part error variance of f refitted with an AR(3) change of the
-// disturbance model beside it (the test beyond a changed noise model).
-double beyond_noise_fit_var(const Context& cx, const OutputFit& f);
 // Whether make_candidate keeps c's columns (Context::keep_series, rebuilding).
 bool keeps_series(const Context& cx, const Candidate& c);
 

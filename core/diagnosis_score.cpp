@@ -14,12 +14,50 @@ namespace mpm::diagnosis {
 
 double Candidate::bic(double log_n) const { return lr - params * log_n; }
 
+namespace {
+
+// What a fit of output j regresses: its whitened residual, or, while
+// accepted signals are refitted jointly, the residual with their part added
+// back (wbase) ...
+const Vec& whitened_residual(const OutputState& o) { return o.signals.empty() ? o.wd : o.wbase; }
+
+// ... on the hypothesis' whitened regressors and those signals.
+std::vector<const Vec*> with_signals(const OutputState& o, std::vector<const Vec*> regs) {
+  if (!o.signals.empty())
+    for (const Vec& w : o.wsignals) regs.push_back(&w);
+  return regs;
+}
+
+// Drops a fit's whitened columns (once scored, nothing reads them).
+void release_whitened(OutputFit& f) {
+  f.whitened_target.resize(0);
+  f.whitened_regressors.clear();
+  f.whitened_regressors.shrink_to_fit();
+}
+
+// The fit of f again with the lags of the residual it leaves as further
+// regressors, on the whitened columns f's own fit used (fit_output keeps
+// them until the candidate is scored). The whitener is linear and starts at
+// rest, so whitening a lagged residual is lagging the whitened one: one
+// filter pass instead of one per lag.
+double beyond_noise_fit_var(const Context& cx, const OutputFit& f) {
+  const OutputState& o = cx.out[f.output];
+  const std::vector<Vec> lags = noise_change_regressors(simulate(o.whitener, o.d - f.correction));
+  std::vector<const Vec*> regs;
+  for (const Vec& x : f.whitened_regressors) regs.push_back(&x);
+  for (const Vec& x : lags) regs.push_back(&x);
+  const Vec& target = f.fixed.size() ? f.whitened_target : whitened_residual(o);
+  return least_squares_at(target, with_signals(o, std::move(regs)), cx.seg, Part::fit).fit_var;
+}
+
+}  // namespace
+
 OutputFit fit_output(const Context& cx, std::size_t j, Vec c0, std::vector<Vec> X) {
   const OutputState& o = cx.out[j];
   OutputFit f;
   f.output = j;
   const bool joint = !o.signals.empty();
-  const Vec& w0 = joint ? o.wbase : o.wd;
+  const Vec& w0 = whitened_residual(o);
   // The whitened columns are the only N-long temporaries; the output's own
   // (w0, its whitened signals) are read in place.
   Vec wc0;
@@ -31,11 +69,8 @@ OutputFit fit_output(const Context& cx, std::size_t j, Vec c0, std::vector<Vec> 
   wx.reserve(X.size());
   for (const Vec& x : X) wx.push_back(simulate(o.whitener, x));
   std::vector<const Vec*> regs;
-  regs.reserve(X.size() + o.wsignals.size());
   for (const Vec& x : wx) regs.push_back(&x);
-  if (joint)
-    for (const Vec& s : o.wsignals) regs.push_back(&s);
-  f.fit = least_squares_at(c0.size() ? wc0 : w0, regs, cx.seg);
+  f.fit = least_squares_at(c0.size() ? wc0 : w0, with_signals(o, std::move(regs)), cx.seg);
   f.whitened_target = std::move(wc0);
   f.whitened_regressors = std::move(wx);
   f.correction = c0.size() ? c0 : Vec::Zero(o.d.size());
@@ -64,12 +99,6 @@ void release_series(Candidate& c) {
   }
 }
 
-void release_whitened(OutputFit& f) {
-  f.whitened_target.resize(0);
-  f.whitened_regressors.clear();
-  f.whitened_regressors.shrink_to_fit();
-}
-
 bool keeps_series(const Context& cx, const Candidate& c) {
   if (cx.keep_series) return true;
   const Candidate* r = cx.rebuilding;
@@ -86,13 +115,9 @@ double objective(const Context& cx, const std::vector<OutputFit>& fits) {
 
 double whitened_objective(const Context& cx, std::size_t j, Vec wc0, const std::vector<const Vec*>& wx) {
   const OutputState& o = cx.out[j];
-  const bool joint = !o.signals.empty();
-  const Vec& w0 = joint ? o.wbase : o.wd;
-  std::vector<const Vec*> regs = wx;
-  if (joint)
-    for (const Vec& w : o.wsignals) regs.push_back(&w);
+  const Vec& w0 = whitened_residual(o);
   if (wc0.size()) wc0 = w0 - wc0;  // coefficient-wise, in place
-  const double var = least_squares_at(wc0.size() ? wc0 : w0, regs, cx.seg, Part::fit).fit_var;
+  const double var = least_squares_at(wc0.size() ? wc0 : w0, with_signals(o, wx), cx.seg, Part::fit).fit_var;
   return std::log(var / o.fit_var) * static_cast<double>(cx.seg.fit_samples());
 }
 
@@ -194,27 +219,6 @@ void score(const Context& cx, Candidate& c) {
     release_whitened(f);
   }
   c.lr_beyond_noise = beyond * static_cast<double>(cx.seg.fit_samples());
-}
-
-// The fit of f again with the lags of the residual it leaves as further
-// regressors, on the whitened columns f's own fit used. The whitener is
-// linear and starts at rest, so whitening a lagged residual is lagging the
-// whitened one: one filter pass instead of one per lag.
-double beyond_noise_fit_var(const Context& cx, const OutputFit& f) {
-  const OutputState& o = cx.out[f.output];
-  if (f.whitened_regressors.size() != f.regressors.size() || (f.fixed.size() && !f.whitened_target.size())) {
-    std::vector<Vec> X = f.regressors;
-    for (Vec& lag : noise_change_regressors(o.d - f.correction)) X.push_back(std::move(lag));
-    return fit_output(cx, f.output, f.fixed, X).fit.fit_var;
-  }
-  const std::vector<Vec> lags = noise_change_regressors(simulate(o.whitener, o.d - f.correction));
-  std::vector<const Vec*> regs;
-  for (const Vec& x : f.whitened_regressors) regs.push_back(&x);
-  for (const Vec& x : lags) regs.push_back(&x);
-  if (!o.signals.empty())
-    for (const Vec& s : o.wsignals) regs.push_back(&s);
-  const Vec& target = f.fixed.size() ? f.whitened_target : (o.signals.empty() ? o.wd : o.wbase);
-  return least_squares_at(target, regs, cx.seg, Part::fit).fit_var;
 }
 
 // The fit-part test and the held-out test are independent under "no
