@@ -138,11 +138,15 @@ ResidualFrontEnd::Stage ResidualFrontEnd::step(const double* u, const double* y,
 
 // ---- 3. The locating rule -------------------------------------------------
 
-RecordVerdict record_verdict(const GrangerMonitor& m) {
+RecordVerdict record_verdict(const GrangerMonitor& m, double family) {
   RecordVerdict v;
   v.loop_mismatch.assign(m.n_outputs(), false);
   v.by_gamma.assign(m.n_outputs() * m.n_inputs(), false);
   const double limit = m.settings().gamma_lambda * m.settings().gamma_lambda;
+  const double level = m.settings().false_alarm / std::max(1.0, family);
+  const double nb = static_cast<double>(m.settings().input_order);
+  const double raise = chi_square_quantile_upper(level, nb);
+  const double joint_raise = chi_square_quantile_upper(level, nb * static_cast<double>(m.n_inputs()));
   for (std::size_t j = 0; j < m.n_outputs(); ++j) {
     if (m.loop(j).diverging) {
       v.diverging = true;
@@ -150,11 +154,11 @@ RecordVerdict record_verdict(const GrangerMonitor& m) {
     }
     bool any = false;
     for (std::size_t i = 0; i < m.n_inputs(); ++i)
-      if (m.channel(j, i).lr_conditional > m.raise_threshold()) {
+      if (m.channel(j, i).lr_conditional > raise) {
         v.located.emplace_back(j, i);
         any = true;
       }
-    if (!any && m.loop(j).lr_joint > m.joint_raise_threshold()) {
+    if (!any && m.loop(j).lr_joint > joint_raise) {
       std::size_t best = m.n_inputs();
       for (std::size_t i = 0; i < m.n_inputs(); ++i)
         if (m.channel(j, i).gamma < limit &&
@@ -165,9 +169,13 @@ RecordVerdict record_verdict(const GrangerMonitor& m) {
         v.by_gamma[j * m.n_inputs() + best] = true;
       }
     }
-    v.loop_mismatch[j] = any || m.loop(j).lr_joint > m.joint_raise_threshold();
+    v.loop_mismatch[j] = any || m.loop(j).lr_joint > joint_raise;
   }
   return v;
+}
+
+double record_test_count(const GrangerMonitor& m) noexcept {
+  return static_cast<double>(m.n_outputs() * (m.n_inputs() + 1));
 }
 
 AlarmFacts alarm_facts(const GrangerMonitor& m, std::size_t output, std::size_t input) noexcept {

@@ -172,13 +172,22 @@ class ResidualFrontEnd {
 // inputs rejects, the paper's two indices name the channel: among those
 // whose AR part matches N^-1 (gamma < lambda^2), the one with the largest
 // pairwise F. Diverging loops locate nothing.
+//
+// `family` shares the level over that many tests: 1 tests each channel and
+// loop at the monitor's false_alarm (the paper's per-channel rule, as `mpm
+// monitor` reports a record); record_test_count() holds the whole record's
+// verdict at false_alarm (what `mpm diagnose` reports beside its
+// family-wise structured tests). Per test, a 3x3 record's 12 tests give a
+// healthy record a mismatch about 1 time in 100.
 struct RecordVerdict {
   std::vector<std::pair<std::size_t, std::size_t>> located;  // (output, input), row major
   std::vector<bool> loop_mismatch;                           // per output
   std::vector<bool> by_gamma;                                // per channel, output major
   bool diverging = false;
 };
-RecordVerdict record_verdict(const GrangerMonitor& monitor);
+RecordVerdict record_verdict(const GrangerMonitor& monitor, double family = 1.0);
+// The end-of-record tests of a record: each channel's and each loop's.
+double record_test_count(const GrangerMonitor& monitor) noexcept;
 
 // What a raise or clear of one channel reports, from the monitor right
 // after the sample that changed it.

@@ -465,6 +465,16 @@ def score(results):
             "confusion": {k: dict(v) for k, v in conf.items()}}
 
 
+def wilson(k, n, z=1.96):
+    """95 % Wilson score interval of a rate k/n."""
+    if n == 0:
+        return 0.0, 1.0
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z / (1 + z * z / n) * (p * (1 - p) / n + z * z / (4 * n * n)) ** 0.5
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
 def print_matrix(s):
     rows = [w for w in WORDS + ["none"] if w in s["confusion"]]
     cols = sorted({c for v in s["confusion"].values() for c in v}, key=lambda c: (
@@ -480,6 +490,10 @@ def print_matrix(s):
           % (s["runs"], s["errors"], s["detect"], s["mismatch_runs"], s["false_alarms"], s["nominal_runs"],
              s["physics_right"], s["true_findings"], 100.0 * s["physics_right"] / max(1, s["true_findings"]),
              s["locate_precision"], s["locate_recall"], s["locate_f1"]))
+    if s["nominal_runs"]:
+        lo, hi = wilson(s["false_alarms"], s["nominal_runs"])
+        print("  false-alarm rate %.2f %% (95 %% CI %.2f-%.2f %%) over %d runs without mismatch" % (
+            100.0 * s["false_alarms"] / s["nominal_runs"], 100 * lo, 100 * hi, s["nominal_runs"]))
     if "detected_true_findings" in s:
         print("  physics where a mismatch was detected: %d/%d (%.0f %%)" % (
             s["detected_physics_right"], s["detected_true_findings"],

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "support/alloc_counter.hpp"
+#include "core/chi_square.hpp"
 #include "core/noise_filter.hpp"
 
 namespace mpm {
@@ -258,6 +259,56 @@ TEST(AlarmEdges, ReportEachRaiseOnceWithItsFacts) {
   int again = 0;
   edges.scan(m, [&](std::size_t, std::size_t, bool raised) { again += raised ? 1 : 0; });
   EXPECT_EQ(again, 1) << "a lowered flag that is still raised is reported again";
+}
+
+
+// The record's verdict shared over its tests: a residual that u1 drives
+// weakly, at the first planted gain whose conditional LR on y1 <- u1 lands
+// between the per-test limit and the family-wise one (the whole record's
+// channels and loops at false_alarm). Per test it is a mismatch, family-wise
+// not; a strong gain is one either way.
+TEST(RecordVerdict, AFamilyWiseLevelFlagsOnlyPastItsStricterLimit) {
+  const PlantModel p = plant(false);
+  MonitorSettings s;
+  s.ar_order = 2;
+  s.input_order = 2;
+  s.forgetting = 1.0;
+  const MonitorBlueprint blueprint(p, s, true);
+  const auto record = [&](double gain) {
+    GrangerMonitor m = blueprint.build();
+    std::mt19937_64 rng(21);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    double u_prev = 0.0;
+    for (int k = 0; k < 3000; ++k) {
+      const double u[] = {normal(rng), normal(rng)};
+      const double d[] = {normal(rng) + gain * u_prev, normal(rng)};
+      u_prev = u[0];
+      m.update(u, d);
+    }
+    return m;
+  };
+  const double per_test = chi_square_quantile_upper(s.false_alarm, 2);
+  double family_wise = 0.0;
+  bool between = false;
+  for (double gain = 0.02; gain < 0.2 && !between; gain += 0.002) {
+    const GrangerMonitor m = record(gain);
+    EXPECT_EQ(record_test_count(m), 6.0) << "2 outputs x (2 channels + the loop)";
+    family_wise = chi_square_quantile_upper(s.false_alarm / record_test_count(m), 2);
+    const double joint_family_wise = chi_square_quantile_upper(s.false_alarm / record_test_count(m), 4);
+    const double lr = m.channel(0, 0).lr_conditional;
+    if (lr <= per_test || lr >= family_wise || m.loop(0).lr_joint >= joint_family_wise) continue;
+    between = true;
+    const RecordVerdict each = record_verdict(m);
+    const RecordVerdict whole = record_verdict(m, record_test_count(m));
+    EXPECT_TRUE(each.loop_mismatch[0]);
+    ASSERT_FALSE(each.located.empty());
+    EXPECT_EQ(each.located.front(), std::make_pair(std::size_t{0}, std::size_t{0}));
+    EXPECT_FALSE(whole.loop_mismatch[0]) << "LR " << lr << " under the family-wise limit " << family_wise;
+    for (const auto& c : whole.located) EXPECT_NE(c.first, 0u);
+  }
+  ASSERT_TRUE(between) << "no planted gain put the LR between " << per_test << " and " << family_wise;
+  const GrangerMonitor strong = record(0.5);
+  EXPECT_TRUE(record_verdict(strong, record_test_count(strong)).loop_mismatch[0]);
 }
 
 }  // namespace
