@@ -13,7 +13,8 @@ random MPC tuning, written as a plant file and run by `plant-nominal`), a
 physics word, a channel / input / output and a magnitude from a range, and a
 simulation seed; simulates the closed loop with `mpm simulate` (`--edit` specs,
 a plant file with a changed noise model, a plant file lacking a channel for
-the diagnosis, the wide-range tank scenarios, the recorded feed flow) and
+the diagnosis, the wide-range tank scenarios or a static map v / (1 + a|v|)
+in front of one channel for `nonlinear_gain`, the recorded feed flow) and
 diagnoses the recording with `mpm diagnose` against the nominal plant file.
 A run whose control-error variance grows by more than 10 % over the matched
 plant's (same seed) is drawn again with a smaller magnitude (up to 4 times):
@@ -212,6 +213,16 @@ def draw_case(rng, word, scale, plants):
         return nominal + (x - nominal) * scale
 
     if word == "nonlinear_gain":
+        if "rand" in plants or rng.random() < 0.5:
+            # a static map in front of one channel: v / (1 + a|v|), a a multiple of
+            # 1 / (the input's RMS deviation from the operating point, set in run_case)
+            key = "rand" if "rand" in plants else rng.choice(["wb", "tt"])
+            p = plants[key]
+            o, i = rng.choice(sorted(p["chans"]))
+            c = toward(0.0, rng.uniform(0.15, 0.6))
+            return (key, {"edits": [], "soft_saturation": (o, i, c)}, None, None,
+                    [{"physics": word, "channels": [(o, i)]}],
+                    "%s %s<-%s soft saturation %.3f / rms" % (key, o, i, c))
         sc = rng.choice(["quad-tank-wide-low", "quad-tank-wide-high"])
         p = PLANTS["qt"]
         return ("qt", {"scenario": sc, "edits": [], "samples": 4000}, None, None,
@@ -325,7 +336,7 @@ def run_case_once(args, index):
     prng = random.Random(args.seed * 7919 + index * 104729 + 17)
     with tempfile.TemporaryDirectory(prefix="mpm_gb_") as tmp:
         plants = dict(PLANTS)
-        if word not in ("nonlinear_gain", "unmodeled_input") and prng.random() < args.random_fraction:
+        if word != "unmodeled_input" and prng.random() < args.random_fraction:
             plants["rand"] = random_plant(prng, tmp)
         if word == "none":
             key = "rand" if "rand" in plants else rng.choice(["wb", "tt", "qt"])
@@ -359,6 +370,10 @@ def run_case_once(args, index):
                 lim = dev[int(q * (len(dev) - 1))]
                 lim = max(lim, 0.0) if side == "upper" else min(lim, 0.0)
                 edits.append("%s.%s=%.4f" % (i, side, lim))
+            if "soft_saturation" in spec:
+                o, i, c = spec["soft_saturation"]
+                rms = (sum((x - u_nom[i][0]) ** 2 for x in u_nom[i]) / len(u_nom[i])) ** 0.5
+                edits.append("%s.%s.soft_saturation=%.5f" % (o, i, c / max(rms, 1e-12)))
             if "deadband" in spec:
                 i, m = spec["deadband"]
                 moves = [abs(a - b) for a, b in zip(u_nom[i][1:], u_nom[i][:-1])]

@@ -70,6 +70,7 @@ void validate(const ChannelEdit& e) {
     fail(e, "time_constant_factor must be > 0");
   if (e.extra_delay < 0) fail(e, "extra_delay must be >= 0 samples");
   if (!(e.extra_lag_pole >= 0.0 && e.extra_lag_pole < 1.0)) fail(e, "extra_lag_pole must be in [0, 1)");
+  if (!(e.soft_saturation >= 0.0) || !std::isfinite(e.soft_saturation)) fail(e, "soft_saturation must be >= 0");
   if (e.replace_continuous && e.replace_discrete) fail(e, "give one replacement form, not both");
 }
 
@@ -77,7 +78,8 @@ void validate(const ChannelEdit& e) {
 
 bool ChannelEdit::changes_nothing() const {
   return gain_factor == 1.0 && pole_factor == 1.0 && time_constant_factor == 1.0 && extra_delay == 0 &&
-         extra_lag_pole == 0.0 && !add_integrator && !replace_continuous && !replace_discrete;
+         extra_lag_pole == 0.0 && !add_integrator && soft_saturation == 0.0 && !replace_continuous &&
+         !replace_discrete;
 }
 
 DiscreteTf edited_channel(const ChannelModel* nominal, const ChannelEdit& e, double sample_time) {

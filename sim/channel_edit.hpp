@@ -24,6 +24,12 @@ struct ChannelEdit {
   int extra_delay = 0;                // samples of pure delay added (>= 0)
   double extra_lag_pole = 0.0;        // unit-gain (1-p)/(1-p q^-1) in series; 0 = none
   bool add_integrator = false;        // G_P = G_M / s (continuous) or G_M Ts/(1-q^-1)
+  // A static map in front of the channel: it acts on v / (1 + a |v|), v its
+  // input's deviation from the operating point (a >= 0; 0 = linear). Odd,
+  // with local gain 1 / (1 + a |v|)^2: a valve or pump whose effect falls
+  // away from the point the model was identified at. Not a transfer
+  // function edit: plant_channels() carries it to the process.
+  double soft_saturation = 0.0;
   // The plant channel is this instead of the model's (a missing channel, a
   // changed structure); the edits above then apply to it.
   std::optional<ContinuousTf> replace_continuous{};  // {}: an edit may be written {.output, .input, .gain_factor}

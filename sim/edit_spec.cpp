@@ -27,6 +27,7 @@ constexpr Key kKeys[] = {
     {"delay", EditField::delay, Range::samples},
     {"lag", EditField::lag, Range::unit_interval},
     {"integrator", EditField::integrator, Range::flag},
+    {"soft_saturation", EditField::soft_saturation, Range::non_negative},
     {"actuator_lag", EditField::actuator_lag, Range::unit_interval},
     {"lower", EditField::lower, Range::at_most_zero},
     {"upper", EditField::upper, Range::at_least_zero},
@@ -112,6 +113,7 @@ void set_field(const EditSpec& s, ChannelEdit& e) {
     case EditField::delay: e.extra_delay = static_cast<int>(s.value); break;
     case EditField::lag: e.extra_lag_pole = s.value; break;
     case EditField::integrator: e.add_integrator = s.value != 0.0; break;
+    case EditField::soft_saturation: e.soft_saturation = s.value; break;
     default: break;
   }
 }

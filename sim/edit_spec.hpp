@@ -28,6 +28,7 @@ enum class EditField {
   delay,          // ChannelEdit::extra_delay, whole samples 0..kMaxEditDelay
   lag,            // ChannelEdit::extra_lag_pole, in [0, 1)
   integrator,     // ChannelEdit::add_integrator, 0 or 1 (no value: 1)
+  soft_saturation,  // ChannelEdit::soft_saturation, >= 0
   actuator_lag,   // InputEdit::actuator_lag_pole, in [0, 1)
   lower,          // InputEdit::lower_limit, <= 0 (deviation from the operating point)
   upper,          // InputEdit::upper_limit, >= 0

@@ -1,6 +1,7 @@
 #include "sim/linear_process.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <stdexcept>
 #include <utility>
@@ -32,7 +33,7 @@ DiscreteTf one_sample_ahead(const DiscreteTf& tf) {
 
 std::vector<LinearChannel> plant_channels(const PlantModel& model, const std::vector<ChannelEdit>& edits) {
   std::vector<LinearChannel> out;
-  for (const auto& c : model.channels) out.push_back({c.output, c.input, c.tf});
+  for (const auto& c : model.channels) out.push_back({c.output, c.input, c.tf, 0.0});
   std::set<std::pair<std::size_t, std::size_t>> edited;
   for (const auto& e : edits) {
     const std::size_t j = index_of(model.outputs, e.output, "output");
@@ -44,8 +45,9 @@ std::vector<LinearChannel> plant_channels(const PlantModel& model, const std::ve
                                  [&](const LinearChannel& c) { return c.output == j && c.input == i; });
     if (it != out.end()) {
       it->tf = std::move(tf);
+      it->soft_saturation = e.soft_saturation;
     } else {
-      out.push_back({j, i, std::move(tf)});
+      out.push_back({j, i, std::move(tf), e.soft_saturation});
     }
   }
   return out;
@@ -59,7 +61,7 @@ LinearProcess::LinearProcess(std::size_t n_inputs, std::size_t n_outputs,
       throw std::invalid_argument("linear plant: channel index out of range");
     if (c.tf.is_zero()) continue;
     try {
-      channels_.push_back({c.output, c.input, DiscreteFilter(one_sample_ahead(c.tf))});
+      channels_.push_back({c.output, c.input, DiscreteFilter(one_sample_ahead(c.tf)), c.soft_saturation});
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument("plant channel (output " + std::to_string(c.output + 1) + ", input " +
                                   std::to_string(c.input + 1) + "): " + e.what());
@@ -71,7 +73,10 @@ void LinearProcess::output(double* y) const noexcept { std::copy(next_y_.begin()
 
 void LinearProcess::advance(const double* u) noexcept {
   std::fill(next_y_.begin(), next_y_.end(), 0.0);
-  for (auto& c : channels_) next_y_[c.output] += c.one_ahead.step(u[c.input]);
+  for (auto& c : channels_) {
+    const double v = u[c.input];
+    next_y_[c.output] += c.one_ahead.step(v / (1.0 + c.soft_saturation * std::abs(v)));
+  }
 }
 
 void LinearProcess::reset() noexcept {

@@ -15,6 +15,7 @@ struct LinearChannel {
   std::size_t output = 0;
   std::size_t input = 0;
   DiscreteTf tf;  // y_output(k) += tf u_input(k); must be strictly proper
+  double soft_saturation = 0.0;  // tf acts on u / (1 + a |u|) (ChannelEdit::soft_saturation)
 };
 
 // The position of `name` in `names`; throws std::invalid_argument "unknown
@@ -44,6 +45,7 @@ class LinearProcess final : public Process {
     std::size_t output;
     std::size_t input;
     DiscreteFilter one_ahead;  // tf with one sample of delay taken out: fed u(k), gives y(k+1)
+    double soft_saturation;
   };
   std::size_t n_inputs_ = 0;
   std::vector<Channel> channels_;

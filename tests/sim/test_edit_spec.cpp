@@ -74,6 +74,8 @@ TEST(EditSpec, EachChannelKeyLeavesTheOtherFieldsAlone) {
   EXPECT_FALSE(p.channels[0].add_integrator);
   EXPECT_FALSE(applied({"y1.u2.integrator=0"}).channels[0].add_integrator);
   EXPECT_TRUE(applied({"y1.u2.integrator=1"}).channels[0].add_integrator);
+  EXPECT_EQ(applied({"y1.u2.soft_saturation=0.3"}).channels[0].soft_saturation, 0.3);
+  EXPECT_EQ(p.channels[0].soft_saturation, nominal.soft_saturation);
 }
 
 TEST(EditSpec, InputAndOutputKeysSetTheirFields) {
@@ -182,6 +184,7 @@ TEST(EditSpec, OutOfRangeValuesAreRefused) {
       {"y2.u1.lag=1", "must be in [0, 1)"},
       {"y2.u1.lag=-0.1", "must be in [0, 1)"},
       {"y2.u1.integrator=2", "must be 1"},
+      {"y2.u1.soft_saturation=-0.1", "must be >= 0"},
       {"u1.actuator_lag=1", "must be in [0, 1)"},
       {"u1.lower=0.5", "must be <= 0"},
       {"u1.upper=-0.5", "must be >= 0"},

@@ -89,6 +89,20 @@ TEST(LinearPlant, GainEditScalesOnlyThatChannelsSteadyState) {
   }
 }
 
+// v / (1 + a|v|) in front of y2 <- u1: a step of +-2 at a = 0.5 acts as
+// +-1, odd; the other channels see the input as it is.
+TEST(LinearPlant, SoftSaturationMapsTheChannelsInputOddly) {
+  const PlantModel m = example_plant("wood-berry.yaml");
+  for (const double step : {2.0, -2.0}) {
+    const auto r = responses(m, one_edit({.output = "y2", .input = "u1", .soft_saturation = 0.5}), {step, 0.0});
+    for (std::size_t k = 0; k < kN; ++k) {
+      EXPECT_DOUBLE_EQ(r.edited[k][0], r.nominal[k][0]);  // y1 <- u1 untouched
+      EXPECT_NEAR(r.edited[k][1], 0.5 * r.nominal[k][1], 1e-9) << "step " << step << " k " << k;
+    }
+    EXPECT_NE(r.nominal.back()[1], 0.0);
+  }
+}
+
 TEST(LinearPlant, DelayEditShiftsTheStepResponse) {
   const PlantModel m = example_plant("wood-berry.yaml");
   const auto r = responses(m, one_edit({.output = "y1", .input = "u2", .extra_delay = 3}), {0.0, 1.0});
