@@ -193,18 +193,20 @@ double fit_mean(const Context& cx, const Vec& x) {
 // mean sits away from the model's operating point makes v^2 a plain gain
 // change in disguise (two gains on one column then lost to one "nonlinear
 // gain"); without the odd term a map such as v (1 + a |v|) looked exactly a
-// gain. So the candidate is only offered when the nonlinear terms are
+// gain. So a candidate is only offered when its nonlinear terms are
 // significant beyond the best linear gains on the same channels (nested
-// likelihood ratio, 2 degrees of freedom per channel, at the family-wise
-// level, Bonferroni over the maps tried): a plain gain change is left to the
-// gain hypotheses.
+// likelihood ratio, one degree of freedom per term and channel): a plain
+// gain change is left to the gain hypotheses.
 void static_map(const Context& cx, const Hypothesis& h, std::size_t i, const std::vector<std::size_t>& js,
                 std::vector<Candidate>& out) {
   const Vec u = cx.problem.du.col(static_cast<Index>(i));
   const Vec v = (u.array() - fit_mean(cx, u)).matrix();
   Vec even = v.cwiseProduct(v);
   even.array() -= fit_mean(cx, even);
-  Vec odd = v.cwiseProduct(v.cwiseAbs());
+  // The odd term bends at the model's operating point (du = 0), where the
+  // model was identified and the map is locally linear; v^2 needs no such
+  // centre (about any level it is v^2 plus linear and constant terms).
+  Vec odd = u.cwiseProduct(u.cwiseAbs());
   double vv = 0.0, ov = 0.0;
   for (Index k = 0; k < v.size(); ++k)
     if (cx.seg.fit[static_cast<std::size_t>(k)]) {
@@ -214,39 +216,52 @@ void static_map(const Context& cx, const Hypothesis& h, std::size_t i, const std
   if (vv <= 0.0) return;
   odd -= (ov / vv) * v;
   odd.array() -= fit_mean(cx, odd);
-  std::vector<OutputFit> fits;
-  double nested = 0.0;
-  for (std::size_t j : js) {
-    const DiscreteTf& g = *cx.channel(j, i);
-    const Vec& lin = cx.gu[j * cx.n_in() + i];
-    const OutputFit linear = fit_output(cx, j, Vec(), {lin});
-    fits.push_back(fit_output(cx, j, Vec(), {lin, simulate(g, even), simulate(g, odd)}));
-    nested += std::log(linear.fit.fit_var / fits.back().fit.fit_var);
+  // The full map (linear, even and odd terms), and each nonlinear term
+  // alone beside the linear one: an even map (v - c v^2) or an odd one
+  // (v / (1 + a |v|)) costs one parameter per channel less, which a weak
+  // bend needs to beat the plain gain on the selection score.
+  struct Form {
+    bool even, odd;
+  };
+  for (const Form form : {Form{true, true}, Form{false, true}, Form{true, false}}) {
+    const int terms = static_cast<int>(form.even) + static_cast<int>(form.odd);
+    std::vector<OutputFit> fits;
+    double nested = 0.0;
+    for (std::size_t j : js) {
+      const DiscreteTf& g = *cx.channel(j, i);
+      const Vec& lin = cx.gu[j * cx.n_in() + i];
+      std::vector<Vec> regs{lin};
+      if (form.even) regs.push_back(simulate(g, even));
+      if (form.odd) regs.push_back(simulate(g, odd));
+      const OutputFit linear = fit_output(cx, j, Vec(), {lin});
+      fits.push_back(fit_output(cx, j, Vec(), regs));
+      nested += std::log(linear.fit.fit_var / fits.back().fit.fit_var);
+    }
+    nested *= static_cast<double>(cx.seg.fit_samples());
+    const auto n_ch = static_cast<int>(js.size());
+    // Whether the bend is there beyond the best linear gains is a choice
+    // between two explanations of a mismatch the candidate's own family-wise
+    // test decides: at Settings::beyond_noise_level, as the other such
+    // choice, not divided over the family (at the family's level a soft
+    // saturation of a quarter of the gain over the input's range was named
+    // a gain on 46 of 120 randomised runs, 33 at this level).
+    if (nested < chi_square_quantile_upper(cx.settings.beyond_noise_level, static_cast<double>(terms * n_ch)))
+      continue;
+    std::vector<Channel> cs = column_channels(js, i);
+    Candidate c = make_candidate(cx, h, cs, fits, (1 + terms) * n_ch);
+    c.finding.nominal = *cx.channel(js[0], i);
+    c.finding.fitted = *cx.channel(js[0], i);
+    c.finding.parameters["nonlinear_lr"] = nested;
+    for (std::size_t r = 0; r < js.size(); ++r) {
+      const LinearFit& f = c.fits[r].fit;
+      const std::string suffix = js.size() == 1 ? std::string() : "_" + cx.problem.outputs[js[r]];
+      c.finding.parameters["gain_factor" + suffix] = 1.0 + f.theta(0);
+      c.finding.parameters["even_coefficient" + suffix] = form.even ? f.theta(1) : 0.0;
+      c.finding.parameters["odd_coefficient" + suffix] = form.odd ? f.theta(form.even ? 2 : 1) : 0.0;
+    }
+    c.facts["working_level"] = cx.problem.u_abs(0, static_cast<Index>(i)) - u(0) + fit_mean(cx, u);
+    out.push_back(std::move(c));
   }
-  nested *= static_cast<double>(cx.seg.fit_samples());
-  const auto n_ch = static_cast<int>(js.size());
-  // Family-wise over every static map tried (each channel, and each column
-  // of two or more channels), as the candidates' own test is.
-  double tests = 0.0;
-  for (std::size_t c = 0; c < cx.n_in(); ++c) {
-    const auto m = static_cast<double>(column_outputs(cx, c).size());
-    tests += m + (m >= 2.0 ? 1.0 : 0.0);
-  }
-  if (nested < chi_square_quantile_upper(cx.settings.alpha / std::max(1.0, tests), 2.0 * n_ch)) return;
-  std::vector<Channel> cs = column_channels(js, i);
-  Candidate c = make_candidate(cx, h, cs, fits);
-  c.finding.nominal = *cx.channel(js[0], i);
-  c.finding.fitted = *cx.channel(js[0], i);
-  c.finding.parameters["nonlinear_lr"] = nested;
-  for (std::size_t r = 0; r < js.size(); ++r) {
-    const LinearFit& f = c.fits[r].fit;
-    const std::string suffix = js.size() == 1 ? std::string() : "_" + cx.problem.outputs[js[r]];
-    c.finding.parameters["gain_factor" + suffix] = 1.0 + f.theta(0);
-    c.finding.parameters["even_coefficient" + suffix] = f.theta(1);
-    c.finding.parameters["odd_coefficient" + suffix] = f.theta(2);
-  }
-  c.facts["working_level"] = cx.problem.u_abs(0, static_cast<Index>(i)) - u(0) + fit_mean(cx, u);
-  out.push_back(std::move(c));
 }
 
 // Gain varying with the output's own level: y = G u (1 + b G u), the

@@ -1,7 +1,7 @@
 // The diagnosis library's static-nonlinearity form (`nonlinear_gain`): a
-// linear, a centred even and an odd term of the input around its working
-// level, offered only when the nonlinear terms are significant beyond the
-// best linear gains (nested test). Two plain gain changes on one input whose
+// linear, a centred even and an odd term of the input (and each nonlinear
+// term alone beside the linear one), offered only when the nonlinear terms
+// are significant beyond the best linear gains (nested test). Two plain gain changes on one input whose
 // level sits away from the model's operating point must stay gains (the old
 // u^2 regressor took them for one column "nonlinear gain"), and an odd
 // map v (1 + a |v|), which an even-only form saw as a gain, must be named.
@@ -92,6 +92,42 @@ TEST(DiagnosisNonlinearGain, OddStaticMapOnOneChannelIsNamed) {
     // y2 is linear and unchanged: nothing there.
     for (const dg::Finding& g : r.findings)
       for (const dg::Channel& c : g.channels) EXPECT_EQ(c.output, 0u) << "seed " << seed << ": " << g.summary;
+  }
+}
+
+// A weak bend costs only its own term: as a soft saturation v / (1 + a |v|)
+// (odd) or a concave map v - c v^2 (even) grows from nothing, it is named
+// on y1 by the linear term and that one term before the full map (a
+// parameter more per channel) beats the plain gain.
+TEST(DiagnosisNonlinearGain, AWeakBendIsNamedWithItsOwnTermAlone) {
+  struct Case {
+    const char* name;
+    double (*map)(double v, double a);
+    std::string term;
+    std::string absent;
+  };
+  const Case cases[] = {
+      {"odd", [](double v, double a) { return v / (1.0 + a * std::abs(v)); }, "odd_coefficient", "even_coefficient"},
+      {"even", [](double v, double a) { return v - a * v * v; }, "even_coefficient", "odd_coefficient"},
+  };
+  for (const Case& c : cases) {
+    std::string seen;
+    bool alone = false;
+    for (double a = 0.005; a < 0.3 && !alone; a *= 1.25) {
+      const dg::Result r = dg::diagnose(column_problem(
+          1, 0.0, [&](double v) { return c.map(v, a); }, [](double v) { return v; }, false));
+      for (const dg::Finding& f : r.findings) {
+        if (f.physics != "nonlinear_gain" || f.channels.size() != 1) continue;
+        seen += f.summary + "; ";
+        EXPECT_EQ(f.channels[0].output, 0u) << c.name << " a " << a << ": " << f.summary;
+        if (f.parameters.at(c.absent) == 0.0) {
+          alone = true;
+          EXPECT_NE(f.parameters.at(c.term), 0.0) << c.name << " a " << a << ": " << f.summary;
+          EXPECT_EQ(f.params, 2) << c.name << " a " << a << ": " << f.summary;
+        }
+      }
+    }
+    EXPECT_TRUE(alone) << c.name << ": never named by its own term alone up to a = 0.3; " << seen;
   }
 }
 
