@@ -203,10 +203,12 @@ void static_map(const Context& cx, const Hypothesis& h, std::size_t i, const std
   const Vec v = (u.array() - fit_mean(cx, u)).matrix();
   Vec even = v.cwiseProduct(v);
   even.array() -= fit_mean(cx, even);
-  // The odd term bends at the model's operating point (du = 0), where the
-  // model was identified and the map is locally linear; v^2 needs no such
-  // centre (about any level it is v^2 plus linear and constant terms).
-  Vec odd = u.cwiseProduct(u.cwiseAbs());
+  // The odd term bends at the input's mean working level: where the plant
+  // file gives no operating point, du = 0 is the record's first sample,
+  // which the shared cases start away from the point their maps bend at
+  // (u1 at 16.7 against 15); v^2 needs no centre (about any level it is v^2
+  // plus linear and constant terms).
+  Vec odd = v.cwiseProduct(v.cwiseAbs());
   double vv = 0.0, ov = 0.0;
   for (Index k = 0; k < v.size(); ++k)
     if (cx.seg.fit[static_cast<std::size_t>(k)]) {
