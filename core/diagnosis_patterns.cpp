@@ -225,19 +225,27 @@ void static_map(const Context& cx, const Hypothesis& h, std::size_t i, const std
   struct Form {
     bool even, odd;
   };
+  // Per channel, once for the three forms: the terms through the channel and
+  // the best linear gain's variance, which each form is nested against.
+  std::vector<Vec> even_response, odd_response;
+  std::vector<double> linear_var;
+  for (std::size_t j : js) {
+    const DiscreteTf& g = *cx.channel(j, i);
+    even_response.push_back(simulate(g, even));
+    odd_response.push_back(simulate(g, odd));
+    linear_var.push_back(fit_output(cx, j, Vec(), {cx.gu[j * cx.n_in() + i]}).fit.fit_var);
+  }
   for (const Form form : {Form{true, true}, Form{false, true}, Form{true, false}}) {
     const int terms = static_cast<int>(form.even) + static_cast<int>(form.odd);
     std::vector<OutputFit> fits;
     double nested = 0.0;
-    for (std::size_t j : js) {
-      const DiscreteTf& g = *cx.channel(j, i);
-      const Vec& lin = cx.gu[j * cx.n_in() + i];
-      std::vector<Vec> regs{lin};
-      if (form.even) regs.push_back(simulate(g, even));
-      if (form.odd) regs.push_back(simulate(g, odd));
-      const OutputFit linear = fit_output(cx, j, Vec(), {lin});
+    for (std::size_t r = 0; r < js.size(); ++r) {
+      const std::size_t j = js[r];
+      std::vector<Vec> regs{cx.gu[j * cx.n_in() + i]};
+      if (form.even) regs.push_back(even_response[r]);
+      if (form.odd) regs.push_back(odd_response[r]);
       fits.push_back(fit_output(cx, j, Vec(), regs));
-      nested += std::log(linear.fit.fit_var / fits.back().fit.fit_var);
+      nested += std::log(linear_var[r] / fits.back().fit.fit_var);
     }
     nested *= static_cast<double>(cx.seg.fit_samples());
     const auto n_ch = static_cast<int>(js.size());
