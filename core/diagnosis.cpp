@@ -2,7 +2,7 @@
 // table that applies (diagnosis_table.cpp), on Settings::threads threads,
 // then taking the best candidate that passes (greedy; a recorded signal
 // already accepted on one output is tested on the others as a family of
-// its own, established_signal()), subtracting its
+// its own, established_signals()), subtracting its
 // correction (or, for a changed disturbance model, changing the output's
 // whitener) and refitting. Afterwards the disturbance-model rows on the
 // outputs no finding explains, at their own level, and the monitor's
@@ -17,6 +17,7 @@
 #include <limits>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <thread>
 
 #include "core/chi_square.hpp"
@@ -254,12 +255,11 @@ bool column_gains_consistent(const Context& cx, const Candidate& c, const std::v
 // family-wise test). On the randomised benchmark a feed flow found on one
 // Wood-Berry output was lost on the other at LR 10-12 with z_hold 3, under
 // the round's limit of 13-19.
-bool established_signal(const Problem& p, const Candidate& c,
-                        const std::set<std::pair<std::size_t, std::size_t>>& used_signals) {
-  if (!c.finding.signal) return false;
-  for (const auto& [j, col] : used_signals)
-    if (p.extra_names[col] == *c.finding.signal) return true;
-  return false;
+std::set<std::string> established_signals(const Problem& p,
+                                          const std::set<std::pair<std::size_t, std::size_t>>& used_signals) {
+  std::set<std::string> names;
+  for (const auto& [j, col] : used_signals) names.insert(p.extra_names[col]);
+  return names;
 }
 
 }  // namespace
@@ -287,11 +287,10 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
     std::vector<Candidate> cands = generate(cx, used, used_signals, noise_changed, groups, progress);
     cx.keep_series = true;
     if (round == 0) family = std::max<double>(1.0, static_cast<double>(cands.size()));
-    double follow_ups = 0.0;
-    for (const auto& c : cands) follow_ups += established_signal(problem, c, used_signals);
-    const auto family_of = [&](const Candidate& c) {
-      return established_signal(problem, c, used_signals) ? follow_ups : family;
-    };
+    const std::set<std::string> established = established_signals(problem, used_signals);
+    const auto follows = [&](const Candidate& c) { return c.finding.signal && established.count(*c.finding.signal); };
+    const auto follow_ups = static_cast<double>(std::count_if(cands.begin(), cands.end(), follows));
+    const auto family_of = [&](const Candidate& c) { return follows(c) ? follow_ups : family; };
     // A recorded signal that explains the residual goes first: while it is
     // in the residual, the controller moves the inputs to cancel it and any
     // fit of the process channels is biased towards explaining it.

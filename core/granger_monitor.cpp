@@ -71,9 +71,8 @@ GrangerMonitor::GrangerMonitor(std::size_t n_inputs, std::size_t n_outputs, cons
   output_used_.assign(n_outputs, 0);
   output_sum_w_.assign(n_outputs, 0.0);
 
-  const double dof = static_cast<double>(nb_);
-  lr_raise_ = chi_square_quantile_upper(settings.false_alarm, dof);
-  lr_joint_raise_ = chi_square_quantile_upper(settings.false_alarm, dof * static_cast<double>(n_inputs));
+  lr_raise_ = raise_threshold_at(settings.false_alarm);
+  lr_joint_raise_ = joint_raise_threshold_at(settings.false_alarm);
   score_raise_ = lr_raise_;
   setup_detectors();
   reset();
@@ -116,6 +115,14 @@ void GrangerMonitor::reset_output(std::size_t j) noexcept {
 }
 
 bool GrangerMonitor::ready() const noexcept { return used_since_reset_ >= static_cast<std::uint64_t>(warmup_); }
+
+double GrangerMonitor::raise_threshold_at(double level) const noexcept {
+  return chi_square_quantile_upper(level, static_cast<double>(nb_));
+}
+
+double GrangerMonitor::joint_raise_threshold_at(double level) const noexcept {
+  return chi_square_quantile_upper(level, static_cast<double>(nb_ * n_inputs_));
+}
 
 double GrangerMonitor::p_value(double lr) const noexcept {
   return chi_square_survival(lr, static_cast<double>(nb_));

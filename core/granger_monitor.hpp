@@ -121,6 +121,10 @@ class GrangerMonitor {
   // End-of-record test thresholds (chi-square quantiles at false_alarm).
   double raise_threshold() const noexcept { return lr_raise_; }
   double joint_raise_threshold() const noexcept { return lr_joint_raise_; }
+  // The same thresholds at another level (false_alarm shared over a family
+  // of tests, record_verdict); not for the hot path.
+  double raise_threshold_at(double level) const noexcept;
+  double joint_raise_threshold_at(double level) const noexcept;
   // p-value of a loop's joint LR (chi-square, n_inputs * nb dof).
   double joint_p_value(double lr) const noexcept;
   // The live detector (thresholds, windows, last statistics): the score of

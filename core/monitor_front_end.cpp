@@ -144,9 +144,8 @@ RecordVerdict record_verdict(const GrangerMonitor& m, double family) {
   v.by_gamma.assign(m.n_outputs() * m.n_inputs(), false);
   const double limit = m.settings().gamma_lambda * m.settings().gamma_lambda;
   const double level = m.settings().false_alarm / std::max(1.0, family);
-  const double nb = static_cast<double>(m.settings().input_order);
-  const double raise = chi_square_quantile_upper(level, nb);
-  const double joint_raise = chi_square_quantile_upper(level, nb * static_cast<double>(m.n_inputs()));
+  const double raise = m.raise_threshold_at(level);
+  const double joint_raise = m.joint_raise_threshold_at(level);
   for (std::size_t j = 0; j < m.n_outputs(); ++j) {
     if (m.loop(j).diverging) {
       v.diverging = true;
