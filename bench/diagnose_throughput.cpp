@@ -22,7 +22,6 @@
 #include "core/diagnosis.hpp"
 #include "core/granger_monitor.hpp"
 #include "daemon/offline.hpp"
-#include "daemon/series_allocator.hpp"
 #include "sim/builtin_plants.hpp"
 #include "sim/closed_loop.hpp"
 #include "sim/scenarios.hpp"
@@ -66,23 +65,12 @@ double process_cpu_seconds() {
 }
 
 // `mpm diagnose --quiet --plant PLANT --data DATA` up to the report: what the
-// command does before it formats the JSON (not timed: a few kB of text).
+// command does before it formats the JSON (not timed: a few kB of text), by
+// the command's own pipeline (daemon/offline.hpp).
 diagnosis::Result diagnose_files(const std::string& plant_path, const std::string& data_path, std::size_t& threads) {
   const PlantModel plant = config::load_plant(plant_path);
-  const config::Recording rec = config::load_recording(data_path);
-  const config::BoundRecording bound = config::bind(plant, rec);
-  const ResidualSeries series = compute_residuals(plant, rec, bound);
-
-  MonitorSettings settings;
-  settings.forgetting = kRecordForgetting;
   threads = replay_threads(plant.n_outputs());
-  const GrangerMonitor monitor = monitor_record(plant, series, settings, threads);
-  const RecordVerdict verdict = record_verdict(monitor);
-
-  const diagnosis::Problem problem = diagnosis_problem(plant, rec, bound, series, verdict);
-  diagnosis::Settings dsettings;
-  dsettings.threads = replay_threads(std::thread::hardware_concurrency());
-  return diagnosis::diagnose(problem, dsettings, nullptr);
+  return diagnose_record(plant, config::load_recording(data_path), {}).result;
 }
 
 extern "C" char** environ;
@@ -174,8 +162,6 @@ std::optional<DiagnoseThroughput> measure_diagnose(std::size_t samples, std::siz
       config::write_recording(data_path, sim::simulate(loop, samples, data_path));
     }
 
-    // The heap as `mpm diagnose` tunes it (daemon/series_allocator.hpp).
-    keep_freed_columns_in_heap();
     struct Run {
       double wall, cpu;
     };

@@ -246,10 +246,11 @@ void diagnose_figure(Plan& plan) {
   }
   const std::string note =
       fmt("%zu-sample closed-loop recording of scenario %s (seed 1; built-in wood-berry.yaml) written to "
-          "temporary files, then diagnosed as `mpm diagnose --quiet` does, by the same library calls in this "
-          "process (not the mpm binary; the same daemon/offline functions as the command): load and "
+          "temporary files, then diagnosed as `mpm diagnose --quiet` does, in this process by the command's "
+          "own pipeline (daemon/offline.hpp diagnose_record, with the command's heap settings): load and "
           "parse plant YAML and CSV, bind, residuals, Granger monitor (forgetting 1) over %zu threads, "
-          "structured hypotheses (core/diagnosis.hpp, generators on every core); JSON report not timed; wall-clock, "
+          "family-wise verdict, structured hypotheses (core/diagnosis.hpp, generators on every core); JSON report "
+          "not timed; wall-clock, "
           "median of %zu runs (fastest %.0f samples/s; %.2f s wall, %.2f s process CPU)",
           d->samples, d->scenario.c_str(), d->threads, d->repeats, d->fastest_samples_per_s, d->wall_seconds,
           d->cpu_seconds);

@@ -162,53 +162,32 @@ int run(int argc, char** argv) {
     const PlantModel plant = config::load_plant(plant_path, limits);
     config::Recording rec = load_data(
         data_path, plant, {args.get("channel").value_or("MPM_SAMPLE"), g_quiet ? "" : "mpm diagnose", limits});
-    const config::BoundRecording bound = config::bind(plant, rec);
-    ResidualSeries series = compute_residuals(plant, rec, bound);
-    progress("residuals computed; running the Granger monitor over the record");
-
-    MonitorSettings settings;
-    settings.forgetting = kRecordForgetting;
     // The HTML report shows the live detector's statistic over this same run.
-    DetectorTrace trace(plant.n_outputs(), args.get("html") ? static_cast<std::size_t>(series.u.rows()) : 0);
-    const GrangerMonitor monitor = monitor_record(plant, series, settings, replay_threads(plant.n_outputs()), false,
-                                                  args.get("html") ? trace.callback() : PartSampleCallback{});
-    // Family-wise, as the structured tests: a healthy record is reported
-    // matched with probability 1 - false_alarm, not per channel.
-    const RecordVerdict verdict = record_verdict(monitor, record_test_count(monitor));
+    DetectorTrace trace(plant.n_outputs(), args.get("html") ? rec.samples() : 0);
+    const RecordDiagnosis d = diagnose_record(
+        plant, std::move(rec),
+        {.verbose = args.flag("verbose"),
+         .progress = g_quiet ? nullptr : &progress,
+         .on_sample = args.get("html") ? trace.callback() : PartSampleCallback{}});
     // A header-only or all-NaN record leaves every statistic at its prior
     // (F = 0, p = 1): that is no evidence of a match, so say so instead of
     // printing "mismatch": false.
-    const std::uint64_t needed = 2 + static_cast<std::uint64_t>(settings.ar_order) +
-                                 plant.n_inputs() * static_cast<std::uint64_t>(settings.input_order);
-    if (monitor.counters().used < needed) {
+    if (!d.decided()) {
       std::fprintf(stderr,
                    "mpm diagnose: cannot decide: %llu of %zu samples could be used (rows with "
                    "every input and output finite, after the model settles); the tests need at "
                    "least %llu\n",
-                   static_cast<unsigned long long>(monitor.counters().used), rec.samples(),
-                   static_cast<unsigned long long>(needed));
+                   static_cast<unsigned long long>(d.monitor.counters().used), d.samples,
+                   static_cast<unsigned long long>(d.needed));
       return kExitUndecided;
     }
 
-    progress("fitting structured hypotheses");
-    const diagnosis::Problem problem = diagnosis_problem(plant, rec, bound, series, verdict);
-    // The fits need only the problem's columns: the recording and the
-    // residual series it was built from are not held while they run.
-    const std::size_t samples = rec.samples();
-    rec.data.resize(0, 0);
-    series = ResidualSeries{};
-    diagnosis::Settings dsettings;
-    dsettings.verbose = args.flag("verbose");
-    dsettings.threads = replay_threads(std::thread::hardware_concurrency());
-    diagnosis::Result result = diagnosis::diagnose(problem, dsettings, g_quiet ? nullptr : &progress);
-    if (verdict.diverging) result.notes.push_back("the monitor finds a diverging loop: its statistics are not trusted");
-
-    const std::string json = report_json(plant, samples, monitor, verdict, result);
+    const std::string json = report_json(plant, d.samples, d.monitor, d.verdict, d.result);
     if (const auto out = args.get("json"))
       config::write_output_file(*out, json);
     else
       config::write_stdout(json);
-    write_products(args, plant_path, data_path, plant, problem, monitor, verdict, result, trace);
+    write_products(args, plant_path, data_path, plant, d.problem, d.monitor, d.verdict, d.result, trace);
     return 0;
   });
 }

@@ -132,4 +132,34 @@ diagnosis::Problem diagnosis_problem(const PlantModel& plant, const config::Reco
   return p;
 }
 
+RecordDiagnosis diagnose_record(const PlantModel& plant, config::Recording&& rec, const RecordDiagnosisOptions& options) {
+  const config::BoundRecording bound = config::bind(plant, rec);
+  ResidualSeries series = compute_residuals(plant, rec, bound);
+  if (options.progress) options.progress("residuals computed; running the Granger monitor over the record");
+  MonitorSettings settings;
+  settings.forgetting = kRecordForgetting;
+  RecordDiagnosis r{.samples = rec.samples(),
+                    .monitor = monitor_record(plant, series, settings, replay_threads(plant.n_outputs()), false,
+                                              options.on_sample)};
+  // Family-wise, as the structured tests: a healthy record is reported
+  // matched with probability 1 - false_alarm, not per channel.
+  r.verdict = record_verdict(r.monitor, record_test_count(r.monitor));
+  r.needed = 2 + static_cast<std::uint64_t>(settings.ar_order) +
+             plant.n_inputs() * static_cast<std::uint64_t>(settings.input_order);
+  if (!r.decided()) return r;
+
+  if (options.progress) options.progress("fitting structured hypotheses");
+  r.problem = diagnosis_problem(plant, rec, bound, series, r.verdict);
+  // The fits need only the problem's columns: the recording and the
+  // residual series it was built from are not held while they run.
+  rec.data.resize(0, 0);
+  series = ResidualSeries{};
+  diagnosis::Settings dsettings;
+  dsettings.verbose = options.verbose;
+  dsettings.threads = replay_threads(std::thread::hardware_concurrency());
+  r.result = diagnosis::diagnose(r.problem, dsettings, options.progress);
+  if (r.verdict.diverging) r.result.notes.push_back("the monitor finds a diverging loop: its statistics are not trusted");
+  return r;
+}
+
 }  // namespace mpm

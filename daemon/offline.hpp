@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -89,5 +90,33 @@ void run_monitor_parallel(GrangerMonitor& monitor, const ResidualSeries& s, std:
 // replayed over `threads` threads by run_monitor_parallel.
 GrangerMonitor monitor_record(const PlantModel& plant, const ResidualSeries& s, const MonitorSettings& settings,
                               std::size_t threads, bool plain_lags = false, const PartSampleCallback& on_sample = {});
+
+// `mpm diagnose` from a loaded recording to its findings, the one pipeline
+// the command runs and `mpm bench` times: residuals by the front end, the
+// Granger monitor over the record (forgetting 1, outputs over threads), its
+// family-wise verdict, then, where the record holds enough usable samples,
+// the structured hypotheses on every core. The recording's columns are
+// released before the fits run: they need only the problem's.
+struct RecordDiagnosisOptions {
+  bool verbose = false;                      // every hypothesis' statistics to `progress`
+  diagnosis::Progress progress = nullptr;    // progress lines (may be empty)
+  PartSampleCallback on_sample;              // the monitor after each sample (the HTML report's trace)
+};
+
+struct RecordDiagnosis {
+  std::size_t samples = 0;  // rows of the recording
+  GrangerMonitor monitor;
+  RecordVerdict verdict{};
+  // Samples the tests need; with fewer usable (every input and output finite,
+  // after the model settles) the record cannot be decided and no hypothesis
+  // is fitted (problem and result stay empty).
+  std::uint64_t needed = 0;
+  diagnosis::Problem problem{};
+  diagnosis::Result result{};
+
+  bool decided() const { return monitor.counters().used >= needed; }
+};
+
+RecordDiagnosis diagnose_record(const PlantModel& plant, config::Recording&& rec, const RecordDiagnosisOptions& options);
 
 }  // namespace mpm
