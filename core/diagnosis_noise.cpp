@@ -1,6 +1,7 @@
-// The disturbance-model hypothesis: where no finding explains an output whose
-// noise model N the plant file gives, a changed N. Tried after the search
-// (diagnose()), at its own family-wise level over the forms and outputs.
+// The disturbance-model hypothesis: a changed noise model N of an output
+// whose N the plant file gives. A candidate of every round, and tried once
+// more after the search where no finding explains the output (diagnose()),
+// there at its own family-wise level over the forms and outputs.
 #include <cmath>
 #include <optional>
 
@@ -37,7 +38,11 @@ void fit_disturbance_model(const Context& cx, const Hypothesis& h, const Site& s
     return least_squares(e, {}, cx.seg, Part::fit).fit_var;
   });
   corrections.push_back(arma(b));
-  const double limit_alpha = fit_level(cx.settings, static_cast<double>(corrections.size() * cx.n_out()));
+  // The evidence every candidate is held to (passes(): the fit-part and
+  // held-out tests together or pooled, or the fit part alone where the
+  // held-out part cannot speak), at the family of these forms over the
+  // outputs; in the rounds the round's family applies on top.
+  const double forms_family = static_cast<double>(corrections.size() * cx.n_out());
   std::optional<Candidate> best;
   DiscreteTf best_correction;
   for (const DiscreteTf& correction : corrections) {
@@ -49,8 +54,7 @@ void fit_disturbance_model(const Context& cx, const Hypothesis& h, const Site& s
     std::vector<OutputFit> fits;
     fits.push_back(std::move(of));
     Candidate c = make_candidate(cx, h, {{j, std::nullopt}}, std::move(fits), params);
-    if (c.lr < chi_square_quantile_upper(limit_alpha, params) || c.z_hold < cx.settings.holdout_z || c.hold_gain <= 0.0)
-      continue;
+    if (!passes(c, cx.settings, forms_family)) continue;
     if (!best || c.bic(std::log(static_cast<double>(n_fit))) > best->bic(std::log(static_cast<double>(n_fit)))) {
       best = std::move(c);
       best_correction = correction;
