@@ -32,6 +32,23 @@ Eigen::VectorXd channel(const Eigen::VectorXd& u) {
   return y;
 }
 
+// An input that steps to a level drawn uniformly in [-amplitude, amplitude]
+// every 5 to 30 samples.
+Eigen::VectorXd random_steps(std::mt19937& rng, Eigen::Index n, double amplitude) {
+  std::uniform_int_distribution<int> hold(5, 30);
+  std::uniform_real_distribution<double> level(-amplitude, amplitude);
+  Eigen::VectorXd u(n);
+  double v = 0.0;
+  for (Eigen::Index k = 0, next = 0; k < n; ++k) {
+    if (k == next) {
+      v = level(rng);
+      next = k + hold(rng);
+    }
+    u(k) = v;
+  }
+  return u;
+}
+
 // u steps within [-1, 1], except once, from `episode` for 80 samples, at
 // 2.5; the plant's actuator stops at 1.2, which only that episode reaches.
 // White disturbances of sd 0.05, as the plant file says (N = 1).
@@ -39,16 +56,9 @@ dg::Problem episode_problem(unsigned seed, Eigen::Index episode) {
   const Eigen::Index n = 3000;
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 0.05);
-  std::uniform_int_distribution<int> hold(5, 30);
-  std::uniform_real_distribution<double> level(-1.0, 1.0);
-  Eigen::VectorXd u(n), plant_u(n);
-  double v = 0.0;
-  for (Eigen::Index k = 0, next = 0; k < n; ++k) {
-    if (k == next) {
-      v = level(rng);
-      next = k + hold(rng);
-    }
-    u(k) = k >= episode && k < episode + 80 ? 2.5 : v;
+  Eigen::VectorXd u = random_steps(rng, n, 1.0), plant_u(n);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    if (k >= episode && k < episode + 80) u(k) = 2.5;
     plant_u(k) = std::min(u(k), 1.2);
   }
   Eigen::VectorXd residual = channel(plant_u) - channel(u);
@@ -83,24 +93,18 @@ TEST(DiagnosisHoldout, LimitReachedOnlyInAFittedEpisodeIsNamed) {
 
 // The plant file says the disturbances are 1 / (1 - 0.8 q^-1) white noise
 // of sd 0.05; the input's channel is right, and the input moves enough that
-// a sensor lag (the changed noise model's near-alias) would show on it. The noise pole is in fact 0.92
-// wherever the third, sixth and ninth tenths of the record lie (the
+// a sensor lag (the changed noise model's near-alias) would show on it. The
+// noise pole is in fact 0.92 wherever the third, sixth and ninth tenths of the record lie (the
 // held-out blocks) and 0.83 elsewhere: on the fit blocks alone the change
 // is too small to pass its limit.
 dg::Problem noise_problem(unsigned seed) {
   const Eigen::Index n = 4000;
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 0.05);
-  std::uniform_int_distribution<int> hold(5, 30);
-  std::uniform_real_distribution<double> level(-3.0, 3.0);
-  Eigen::VectorXd u(n), residual(n);
-  double v = 0.0, d = 0.0;
-  for (Eigen::Index k = 0, next = 0; k < n; ++k) {
-    if (k == next) {
-      v = level(rng);
-      next = k + hold(rng);
-    }
-    u(k) = v;
+  const Eigen::VectorXd u = random_steps(rng, n, 3.0);
+  Eigen::VectorXd residual(n);
+  double d = 0.0;
+  for (Eigen::Index k = 0; k < n; ++k) {
     const bool held_out_block = (k / (n / 10)) % 3 == 2;
     d = (held_out_block ? 0.92 : 0.83) * d + noise(rng);
     residual(k) = d;
