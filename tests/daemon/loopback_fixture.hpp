@@ -30,6 +30,13 @@ inline const std::string kMpm = MPM_BINARY_DIR "/daemon/mpm";
 inline const std::string kLoopbackXml = MPM_SOURCE_DIR "/deploy/dds/cyclonedds-loopback.xml";
 // How long a daemon may take to say its first status (and DDS to match readers).
 inline constexpr std::chrono::seconds kStartTimeout{30};
+// DDS keep-last depth of the tests' sample writers and readers. `mpm replay`
+// and `simulate-live` publish up to 500 samples at 2000-3000 per second, and
+// a sanitized mpmd on a loaded machine can fall more than the default 64
+// (32 ms) behind: keep-last then drops samples by design (never blocking the
+// controller; they show up as gaps). A depth above any test's record makes
+// reliable delivery complete, so "mpmd saw every sample" is deterministic.
+inline constexpr int kSampleHistory = 1024;
 
 // One publishing controller: the Wood-Berry stream with sequence numbers.
 struct Controller {
@@ -60,6 +67,7 @@ class LoopbackTest : public ::testing::TestWithParam<transport::Kind> {
     settings_.lcm.url = "udpm://239.255.76.67:" + std::to_string(20000 + slot * 7) + "?ttl=0";
     settings_.dds.domain = 1 + slot;
     settings_.dds.config = kLoopbackXml;
+    settings_.dds.sample_history = kSampleHistory;
     ASSERT_FALSE(dir_.path().empty());
   }
 
@@ -73,7 +81,8 @@ class LoopbackTest : public ::testing::TestWithParam<transport::Kind> {
   std::string transport_yaml() const {
     return std::string("transport:\n  kind: ") + transport::to_string(settings_.kind) + "\n" +
            "  lcm: {url: \"" + settings_.lcm.url + "\"}\n" +
-           "  dds: {domain: " + std::to_string(settings_.dds.domain) + ", config: " + kLoopbackXml + "}\n";
+           "  dds: {domain: " + std::to_string(settings_.dds.domain) + ", config: " + kLoopbackXml +
+           ", sample_history: " + std::to_string(settings_.dds.sample_history) + "}\n";
   }
   // An mpmd.yaml for `controller`, written to the test's directory.
   std::string write_config(const std::string& name, const std::string& controller,
