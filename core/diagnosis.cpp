@@ -191,6 +191,7 @@ Finding monitor_fallback(const Context& cx, std::size_t j) {
 // places on records the project had not seen (issue 13).
 constexpr double kAliasAbsolute = 3.84;
 constexpr double kAliasRelative = 0.03;
+double alias_margin(double score) { return std::max(kAliasAbsolute, kAliasRelative * std::abs(score)); }
 
 // Whether two findings speak of the same place: a channel in common, or one
 // output where either has no input (a changed disturbance model beside a
@@ -211,7 +212,7 @@ bool same_place(const Finding& a, const Finding& b) {
 std::vector<std::string> alternatives(const Context& cx, const Candidate& best, const std::vector<Candidate>& cands,
                                       double family, double log_n) {
   const double top = selection_score(cx, best, log_n);
-  const double margin = std::max(kAliasAbsolute, kAliasRelative * std::abs(top));
+  const double margin = alias_margin(top);
   std::vector<std::pair<double, std::string>> near;
   for (const auto& c : cands) {
     if (c.finding.physics == best.finding.physics || c.finding.signal != best.finding.signal ||
@@ -243,7 +244,7 @@ bool column_gains_consistent(const Context& cx, const Candidate& c, const std::v
       double& slot = o.hypothesis->physics == Physics::gain ? gain : other;
       slot = std::max(slot, selection_score(cx, o, log_n));
     }
-    if (gain < other - std::max(kAliasAbsolute, kAliasRelative * std::abs(other))) return false;
+    if (gain < other - alias_margin(other)) return false;
   }
   return true;
 }
@@ -262,7 +263,7 @@ const Candidate* actuator_over_channel_lag(const Context& cx, const Candidate& b
   if (best.hypothesis->physics != Physics::unmodeled_dynamics || best.finding.channels.size() != 1) return &best;
   const Channel& ch = best.finding.channels[0];
   const double top = selection_score(cx, best, log_n);
-  const double margin = std::max(kAliasAbsolute, kAliasRelative * std::abs(top));
+  const double margin = alias_margin(top);
   const Candidate* pick = &best;
   double pick_score = -std::numeric_limits<double>::infinity();
   for (const Candidate& c : cands) {
