@@ -141,9 +141,13 @@ RecordDiagnosis diagnose_record(const PlantModel& plant, config::Recording&& rec
   RecordDiagnosis r{.samples = rec.samples(),
                     .monitor = monitor_record(plant, series, settings, replay_threads(plant.n_outputs()), false,
                                               options.on_sample)};
-  // Family-wise, as the structured tests: a healthy record is reported
-  // matched with probability 1 - false_alarm, not per channel.
-  r.verdict = record_verdict(r.monitor, record_test_count(r.monitor));
+  // Family-wise, and at a tenth of the structured tests' level: the
+  // monitor's verdict only adds a mismatch no hypothesis explains (`other`),
+  // so a healthy record is reported matched with probability about
+  // 1 - 1.1 false_alarm, not 1 - 2 false_alarm. The structured tests are the
+  // stronger detector: on the randomised benchmark the monitor flagged no
+  // mismatch they all missed in 740 runs, and 4 of 1800 runs without one.
+  r.verdict = record_verdict(r.monitor, record_test_count(r.monitor) / kUnexplainedShare);
   r.needed = 2 + static_cast<std::uint64_t>(settings.ar_order) +
              plant.n_inputs() * static_cast<std::uint64_t>(settings.input_order);
   if (!r.decided()) return r;

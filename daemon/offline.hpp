@@ -103,10 +103,14 @@ struct RecordDiagnosisOptions {
   PartSampleCallback on_sample;              // the monitor after each sample (the HTML report's trace)
 };
 
+// The share of the false-alarm level that `mpm diagnose` gives the
+// monitor's record verdict, beside the structured tests' full level.
+inline constexpr double kUnexplainedShare = 0.1;
+
 struct RecordDiagnosis {
   std::size_t samples = 0;  // rows of the recording
   GrangerMonitor monitor;
-  RecordVerdict verdict{};
+  RecordVerdict verdict{};  // at kUnexplainedShare of the monitor's false_alarm, family-wise
   // Samples the tests need; with fewer usable (every input and output finite,
   // after the model settles) the record cannot be decided and no hypothesis
   // is fitted (problem and result stay empty).
