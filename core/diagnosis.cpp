@@ -128,7 +128,7 @@ std::vector<Candidate> generate(const Context& cx, const std::set<std::pair<std:
 }
 
 // The verbose line of one candidate.
-std::string describe(const Context& cx, const Candidate& c, double family, double log_n) {
+std::string describe(const Context& cx, const Candidate& c, double family) {
   const Problem& p = cx.problem;
   std::string m = "  candidate " + c.finding.physics + " [";
   for (const auto& ch : c.finding.channels)
@@ -136,8 +136,8 @@ std::string describe(const Context& cx, const Candidate& c, double family, doubl
   return m + "] lr " + fmt(c.lr, 4) + " (limit " + fmt(fit_limit(cx.settings, family, c.params), 3) +
          ", pooled with z_hold^2 " + fmt(pooled_limit(cx.settings, family, c.params), 3) + ") z_hold " +
          fmt(c.z_hold, 3) + " (expected " + fmt(c.z_expected, 3) + ")" +
-         " beyond_noise " + fmt(c.lr_beyond_noise, 4) + " bic " + fmt(c.bic(log_n), 4) + " selection " +
-         fmt(selection_score(cx, c, log_n), 4) + ": " + c.finding.summary;
+         " beyond_noise " + fmt(c.lr_beyond_noise, 4) + " aic " + fmt(c.aic(), 4) + " selection " +
+         fmt(selection_score(cx, c), 4) + ": " + c.finding.summary;
 }
 
 // Takes the chosen candidate's correction out of its outputs' residuals: a
@@ -184,7 +184,7 @@ Finding monitor_fallback(const Context& cx, std::size_t j) {
   return f;
 }
 
-// How close in selection score (a deviance: BIC on the fit part plus the
+// How close in selection score (a deviance: AIC on the fit part plus the
 // held-out log-likelihood gain) another word must come to be an alternative:
 // the larger of 3.84 (the 95 % chi-square(1) quantile) and 3 % of the chosen
 // score, the spread within which gain and time constant were seen to trade
@@ -210,15 +210,15 @@ bool same_place(const Finding& a, const Finding& b) {
 // lag beside a changed disturbance model where the process part carries
 // little of it. The chosen word is not changed.
 std::vector<std::string> alternatives(const Context& cx, const Candidate& best, const std::vector<Candidate>& cands,
-                                      double family, double log_n) {
-  const double top = selection_score(cx, best, log_n);
+                                      double family) {
+  const double top = selection_score(cx, best);
   const double margin = alias_margin(top);
   std::vector<std::pair<double, std::string>> near;
   for (const auto& c : cands) {
     if (c.finding.physics == best.finding.physics || c.finding.signal != best.finding.signal ||
         !same_place(c.finding, best.finding) || !passes(c, cx.settings, family))
       continue;
-    const double score_c = selection_score(cx, c, log_n);
+    const double score_c = selection_score(cx, c);
     if (top - score_c <= margin) near.push_back({score_c, c.finding.physics});
   }
   std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
@@ -232,8 +232,7 @@ std::vector<std::string> alternatives(const Context& cx, const Candidate& best, 
 // channels, the channel's own gain is as good an explanation as the best
 // other form there (within the alias margin): otherwise a strong lag on one
 // channel would be named a gain because a strong gain rides on another.
-bool column_gains_consistent(const Context& cx, const Candidate& c, const std::vector<Candidate>& cands,
-                             double log_n) {
+bool column_gains_consistent(const Context& cx, const Candidate& c, const std::vector<Candidate>& cands) {
   if (c.hypothesis->physics != Physics::gain || c.hypothesis->scope != Scope::column) return true;
   for (const Channel& ch : c.finding.channels) {
     double gain = -std::numeric_limits<double>::infinity(), other = gain;
@@ -242,7 +241,7 @@ bool column_gains_consistent(const Context& cx, const Candidate& c, const std::v
           o.finding.channels[0].output != ch.output || o.finding.channels[0].input != ch.input)
         continue;
       double& slot = o.hypothesis->physics == Physics::gain ? gain : other;
-      slot = std::max(slot, selection_score(cx, o, log_n));
+      slot = std::max(slot, selection_score(cx, o));
     }
     if (gain < other - alias_margin(other)) return false;
   }
@@ -259,10 +258,10 @@ bool column_gains_consistent(const Context& cx, const Candidate& c, const std::v
 // its alternative. A prior, not evidence: on the randomised benchmark it
 // named 3 actuator lags right and 2 extra lags wrong (docs/method.md).
 const Candidate* actuator_over_channel_lag(const Context& cx, const Candidate& best,
-                                           const std::vector<Candidate>& cands, double family, double log_n) {
+                                           const std::vector<Candidate>& cands, double family) {
   if (best.hypothesis->physics != Physics::unmodeled_dynamics || best.finding.channels.size() != 1) return &best;
   const Channel& ch = best.finding.channels[0];
-  const double top = selection_score(cx, best, log_n);
+  const double top = selection_score(cx, best);
   const double margin = alias_margin(top);
   const Candidate* pick = &best;
   double pick_score = -std::numeric_limits<double>::infinity();
@@ -270,12 +269,40 @@ const Candidate* actuator_over_channel_lag(const Context& cx, const Candidate& b
     if (c.hypothesis->physics != Physics::actuator_dynamics || !passes(c, cx.settings, family)) continue;
     bool covers = false;
     for (const Channel& x : c.finding.channels) covers = covers || (x.output == ch.output && x.input == ch.input);
-    const double score_c = selection_score(cx, c, log_n);
+    const double score_c = selection_score(cx, c);
     if (covers && top - score_c <= margin && score_c > pick_score) {
       pick = &c;
       pick_score = score_c;
     }
   }
+  return pick;
+}
+
+// The chosen word's form: among its candidates on the same channels (and
+// signal) that pass, the one with the best BIC on the fit part plus the
+// held-out gain. The word is chosen by the whole record's out-of-sample
+// log-likelihood (selection_score); how many parameters its correction
+// carries (a static map's odd term alone or with the even one) is a
+// question of parsimony, where BIC's ln n per parameter keeps a term the
+// data do not demand out of the reported fit.
+const Candidate* simplest_form(const Context& cx, const Candidate& best, const std::vector<Candidate>& cands,
+                               double family) {
+  const double log_n = std::log(static_cast<double>(cx.seg.fit_samples()));
+  const auto parsimonious = [&](const Candidate& c) {
+    return c.bic(log_n) + static_cast<double>(cx.seg.hold_samples()) * c.hold_gain;
+  };
+  const auto same_channels = [](const Finding& a, const Finding& b) {
+    if (a.channels.size() != b.channels.size()) return false;
+    for (std::size_t k = 0; k < a.channels.size(); ++k)
+      if (a.channels[k].output != b.channels[k].output || a.channels[k].input != b.channels[k].input) return false;
+    return true;
+  };
+  const Candidate* pick = &best;
+  for (const Candidate& c : cands)
+    if (c.hypothesis->physics == best.hypothesis->physics && c.finding.signal == best.finding.signal &&
+        same_channels(c.finding, best.finding) && parsimonious(c) > parsimonious(*pick) &&
+        passes(c, cx.settings, family))
+      pick = &c;
   return pick;
 }
 
@@ -311,7 +338,6 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
   std::vector<bool> explained(cx.n_out(), false);
   std::vector<bool> noise_changed(cx.n_out(), false);
   double family = 0.0;
-  const double log_n = std::log(static_cast<double>(cx.seg.fit_samples()));
   for (int round = 0; round < settings.max_findings; ++round) {
     Groups groups;
     cx.keep_series = false;
@@ -330,20 +356,21 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
     const Candidate* best = nullptr;
     double best_score = -std::numeric_limits<double>::infinity();
     for (const auto& c : cands) {
-      if (settings.verbose && progress) progress(describe(cx, c, family_of(c), log_n).c_str());
+      if (settings.verbose && progress) progress(describe(cx, c, family_of(c)).c_str());
       if (!passes(c, settings, family_of(c)) || (signal_first && !c.finding.signal) ||
-          !column_gains_consistent(cx, c, cands, log_n))
+          !column_gains_consistent(cx, c, cands))
         continue;
-      const double score_c = selection_score(cx, c, log_n);
+      const double score_c = selection_score(cx, c);
       if (score_c > best_score) {
         best_score = score_c;
         best = &c;
       }
     }
     if (!best) break;
-    best = actuator_over_channel_lag(cx, *best, cands, family_of(*best), log_n);
+    best = simplest_form(cx, *best, cands, family_of(*best));
+    best = actuator_over_channel_lag(cx, *best, cands, family_of(*best));
     // Alternatives share the chosen one's signal, so its family.
-    std::vector<std::string> alias = alternatives(cx, *best, cands, family_of(*best), log_n);
+    std::vector<std::string> alias = alternatives(cx, *best, cands, family_of(*best));
     const Candidate chosen = rebuild_chosen(cx, groups, *best);
     best = &chosen;
     Finding f = best->finding;

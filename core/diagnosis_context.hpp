@@ -112,6 +112,7 @@ struct Candidate {
   std::size_t group = 0;
   std::size_t rank = 0;
   double bic(double log_n) const;  // lr - params ln n
+  double aic() const;              // lr - 2 params
 };
 
 // Drops a scored candidate's N-long columns; its numbers stay.
@@ -164,7 +165,7 @@ void refresh(Context& cx, std::size_t j);
 
 // Selection tests (diagnosis_score.cpp). The fit-part level of the family
 // of `family` candidates; whether c passes the fit, held-out and its row's
-// gate; its selection score (BIC on the fit part plus the held-out
+// gate; its selection score (AIC on the fit part plus the held-out
 // log-likelihood gain); the fit block of its finding (and the raw one).
 double fit_level(const Settings& s, double family);
 // The fit-part limit of a candidate with `params` parameters (with the
@@ -174,7 +175,7 @@ double pooled_limit(const Settings& s, double family, int params);
 // The fit-part limit where the held-out part is uninformative (see passes()).
 double uninformed_limit(const Settings& s, double family, int params);
 bool passes(const Candidate& c, const Settings& s, double family);
-double selection_score(const Context& cx, const Candidate& c, double log_n);
+double selection_score(const Context& cx, const Candidate& c);
 FitNumbers fit_numbers(const Context& cx, const Candidate& c, FitNumbers& raw);
 
 
