@@ -15,8 +15,9 @@
 // Parameters are fitted on seven of ten interleaved blocks; each candidate must
 // pass a likelihood-ratio test there (chi-square, Bonferroni over all the
 // candidates tried) and improve the prediction on the held-out part
-// (the other three blocks), which it never saw. Candidates are chosen greedily: the best by AIC on the fit part plus the held-out log-likelihood gain is
-// accepted, its correction is subtracted, and the rest are refitted. Recorded
+// (the other three blocks), which it never saw. Candidates are chosen
+// greedily: the best by AIC on the fit part plus the held-out log-likelihood
+// gain is accepted, its correction is subtracted, and the rest are refitted. Recorded
 // signals accepted as unmodeled inputs of an output stay free regressors of
 // that output: every later hypothesis there is fitted jointly with them and
 // tested against the signals-only fit, so it must earn its place conditional
