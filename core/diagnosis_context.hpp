@@ -137,6 +137,13 @@ double objective(const Context& cx, const OutputFit& fit);
 // searches that form them in fewer filter passes (filters in series, or a
 // lag of a whitened column, the whitener being linear and at rest at 0).
 double whitened_objective(const Context& cx, std::size_t j, Vec wc0, const std::vector<const Vec*>& wx);
+// The held-out projection test of a correction, from the whitened
+// held-out errors before (e0) and after (e1) it, per output (score()).
+struct HoldoutProjection {
+  double z = 0.0;           // N(0, 1) when the correction is unrelated to e0
+  double z_expected = 0.0;  // what z would be on average were the correction exactly right
+};
+HoldoutProjection project_holdout(const Context& cx, const std::vector<std::pair<const Vec*, const Vec*>>& errors);
 // Fills lr, z_hold, hold_gain and lr_beyond_noise.
 void score(const Context& cx, Candidate& c);
 // Regressors of a change of output j's disturbance model given residual r:
@@ -175,6 +182,10 @@ double pooled_limit(const Settings& s, double family, int params);
 // The fit-part limit where the held-out part is uninformative (see passes()).
 double uninformed_limit(const Settings& s, double family, int params);
 bool passes(const Candidate& c, const Settings& s, double family);
+// Whether terms added to a fitted form (`df` more parameters) are there:
+// their nested likelihood ratio on the fit part pooled with the held-out
+// projection z of what they change, at `level`.
+bool beyond_nested(double nested_lr, double z_hold, int df, double level);
 double selection_score(const Context& cx, const Candidate& c);
 FitNumbers fit_numbers(const Context& cx, const Candidate& c, FitNumbers& raw);
 

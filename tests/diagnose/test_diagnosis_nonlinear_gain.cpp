@@ -5,6 +5,10 @@
 // level sits away from the model's operating point must stay gains (the old
 // u^2 regressor took them for one column "nonlinear gain"), and an odd
 // map v (1 + a |v|), which an even-only form saw as a gain, must be named.
+// The nested test pools the fit part's nested LR with the held-out
+// projection of the bend (beyond_nested): a bend under the fit part's own
+// limit is named when the held-out blocks confirm it, and a bend the
+// held-out blocks contradict is not.
 #include <cmath>
 #include <cstddef>
 #include <random>
@@ -12,7 +16,8 @@
 
 #include <gtest/gtest.h>
 
-#include "core/diagnosis.hpp"
+#include "core/chi_square.hpp"
+#include "core/diagnosis_context.hpp"
 
 namespace {
 
@@ -129,6 +134,69 @@ TEST(DiagnosisNonlinearGain, AWeakBendIsNamedWithItsOwnTermAlone) {
     }
     EXPECT_TRUE(alone) << c.name << ": never named by its own term alone up to a = 0.3; " << seen;
   }
+}
+
+// The rule itself, at the level the static map uses (1 %, one term on one
+// channel: the fit part's limit alone is 6.63, the pooled one 9.21).
+TEST(DiagnosisNonlinearGain, TheBendsNestedTestPoolsTheHeldOutPart) {
+  const double level = dg::Settings{}.beyond_noise_level;
+  // Under the fit part's limit, confirmed on the held-out part: there.
+  EXPECT_TRUE(dg::beyond_nested(5.0, 2.5, 1, level));
+  // Past the fit part's limit but contradicted on the held-out part: not.
+  EXPECT_FALSE(dg::beyond_nested(8.0, -0.5, 1, level));
+  // Pooled just under the limit: not; just over it: there.
+  const double limit = mpm::chi_square_quantile_upper(level, 2);
+  EXPECT_FALSE(dg::beyond_nested(limit - 1.0 - 0.01, 1.0, 1, level));
+  EXPECT_TRUE(dg::beyond_nested(limit - 1.0 + 0.01, 1.0, 1, level));
+  // More terms, more degrees of freedom.
+  EXPECT_FALSE(dg::beyond_nested(limit, 1.0, 2, level));
+}
+
+// A soft saturation v / (1 + a |v|) growing from nothing: at some strength
+// it is named while its fit part alone is under that part's own limit
+// (nonlinear_lr below the chi-square quantile of its terms), admitted by
+// the held-out confirmation (nonlinear_holdout_z > 0): the fit part alone
+// would have left it a gain.
+TEST(DiagnosisNonlinearGain, ABendTheHeldOutPartConfirmsIsNamedUnderTheFitPartsLimit) {
+  const double level = dg::Settings{}.beyond_noise_level;
+  std::string seen;
+  bool pooled = false;
+  for (unsigned seed : {1u, 2u, 3u})
+    for (double a = 0.005; a < 0.3 && !pooled; a *= 1.15) {
+      const dg::Result r = dg::diagnose(column_problem(
+          seed, 0.0, [&](double v) { return v / (1.0 + a * std::abs(v)); }, [](double v) { return v; }, false));
+      for (const dg::Finding& f : r.findings) {
+        if (f.physics != "nonlinear_gain") continue;
+        const double lr = f.parameters.at("nonlinear_lr");
+        const double z = f.parameters.at("nonlinear_holdout_z");
+        seen += "seed " + std::to_string(seed) + " a " + std::to_string(a) + ": LR " + std::to_string(lr) + " z " +
+                std::to_string(z) + "; ";
+        EXPECT_GT(z, 0.0) << f.summary;
+        // (1 + terms) parameters per channel: terms x channels beyond the gains.
+        const int df = f.params - static_cast<int>(f.channels.size());
+        if (lr < mpm::chi_square_quantile_upper(level, df)) pooled = true;
+      }
+    }
+  EXPECT_TRUE(pooled) << "every bend named was past the fit part's limit alone: " << seen;
+}
+
+// Plain gains on one channel, over many seeds, stay gains: the held-out
+// part must confirm a bend, so a fit-part wiggle of a linear change is not
+// called a static map.
+TEST(DiagnosisNonlinearGain, APlainGainIsRarelyCalledAStaticMap) {
+  int gains = 0, maps = 0;
+  for (unsigned seed = 1; seed <= 30; ++seed) {
+    const double factor = seed % 2 ? 1.3 : 0.75;
+    const dg::Result r = dg::diagnose(column_problem(
+        seed, 0.0, [&](double v) { return factor * v; }, [](double v) { return v; }, false));
+    for (const dg::Finding& f : r.findings) {
+      gains += f.physics == "gain";
+      maps += f.physics == "nonlinear_gain";
+    }
+  }
+  // Three forms tried at 1 % each: a few percent at most.
+  EXPECT_LE(maps, 1);
+  EXPECT_GE(gains, 29);
 }
 
 }  // namespace
