@@ -226,17 +226,15 @@ void static_map(const Context& cx, const Hypothesis& h, std::size_t i, const std
     bool even, odd;
   };
   // Per channel, once for the three forms: the terms through the channel and
-  // the best linear gain's variance, which each form is nested against.
+  // the best linear gain's fit (its variance and held-out errors), which
+  // each form is nested against.
   std::vector<Vec> even_response, odd_response;
-  std::vector<double> linear_var;
-  std::vector<Vec> linear_hold_error;
+  std::vector<LinearFit> linear;
   for (std::size_t j : js) {
     const DiscreteTf& g = *cx.channel(j, i);
     even_response.push_back(simulate(g, even));
     odd_response.push_back(simulate(g, odd));
-    LinearFit linear = fit_output(cx, j, Vec(), {cx.gu[j * cx.n_in() + i]}).fit;
-    linear_var.push_back(linear.fit_var);
-    linear_hold_error.push_back(std::move(linear.hold_error));
+    linear.push_back(fit_output(cx, j, Vec(), {cx.gu[j * cx.n_in() + i]}).fit);
   }
   for (const Form form : {Form{true, true}, Form{false, true}, Form{true, false}}) {
     const int terms = static_cast<int>(form.even) + static_cast<int>(form.odd);
@@ -248,11 +246,11 @@ void static_map(const Context& cx, const Hypothesis& h, std::size_t i, const std
       if (form.even) regs.push_back(even_response[r]);
       if (form.odd) regs.push_back(odd_response[r]);
       fits.push_back(fit_output(cx, j, Vec(), regs));
-      nested += std::log(linear_var[r] / fits.back().fit.fit_var);
+      nested += std::log(linear[r].fit_var / fits.back().fit.fit_var);
     }
     nested *= static_cast<double>(cx.seg.fit_samples());
     std::vector<std::pair<const Vec*, const Vec*>> bend_errors;
-    for (std::size_t r = 0; r < js.size(); ++r) bend_errors.push_back({&linear_hold_error[r], &fits[r].fit.hold_error});
+    for (std::size_t r = 0; r < js.size(); ++r) bend_errors.push_back({&linear[r].hold_error, &fits[r].fit.hold_error});
     const double z_bend = project_holdout(cx, bend_errors).z;
     const auto n_ch = static_cast<int>(js.size());
     // Whether the bend is there beyond the best linear gains is a choice

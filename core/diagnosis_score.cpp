@@ -166,14 +166,9 @@ HoldoutProjection project_holdout(const Context& cx, const std::vector<std::pair
   // whitener knows, a slowly varying correction lines up with them by chance
   // far more often, and the test must not take that for evidence.
   constexpr Index kLags = 20;
-  const Index nh = static_cast<Index>(cx.seg.hold.size());
-  // The held-out part as runs of consecutive samples (lags stay inside one).
-  std::vector<std::pair<Index, Index>> runs;
-  for (Index k = 0; k < nh; ++k) {
-    if (!cx.seg.hold[static_cast<std::size_t>(k)]) continue;
-    if (runs.empty() || runs.back().second != k) runs.push_back({k, k});
-    runs.back().second = k + 1;
-  }
+  // The held-out part as runs of consecutive samples (lags stay inside one),
+  // indexed once by prepare().
+  const auto& runs = cx.seg.hold_runs;
   double num = 0.0, var = 0.0, energy = 0.0;
   std::array<double, kLags + 1> gamma{}, cross{};
   std::array<Index, kLags + 1> pairs{};
@@ -276,17 +271,18 @@ bool passes(const Candidate& c, const Settings& s, double family) {
     evidence = c.lr >= uninformed_limit(s, family, c.params);
   } else {
     const bool both = c.lr >= fit_limit(s, family, c.params) && c.z_hold >= s.holdout_z;
-    const bool pooled = c.z_hold > 0.0 && c.lr + c.z_hold * c.z_hold >= pooled_limit(s, family, c.params);
+    const bool pooled = beyond_nested(c.lr, c.z_hold, c.params, 0.5 * s.alpha / family);
     evidence = (both || pooled) && c.hold_gain > 0.0;
   }
   return evidence && (c.hypothesis->gate != Gate::beyond_noise ||
                       c.lr_beyond_noise >= chi_square_quantile_upper(s.beyond_noise_level, c.params));
 }
 
-// The nested test pools the two parts as passes() does: the fit part's
-// nested LR (chi-square with df degrees of freedom when the terms are not
-// there) plus z^2 of the held-out projection (one more, independent of it),
-// with z > 0. Both parts then speak: a weak bend that the fit part alone
+// The two parts' evidence pooled, for the pooled branch of passes() (the
+// terms: the candidate's correction) and for terms added to a fitted form:
+// the fit part's nested LR (chi-square with df degrees of freedom when the
+// terms are not there) plus z^2 of the held-out projection (one more,
+// independent of it), with z > 0. Both parts then speak: a weak bend that the fit part alone
 // left under its limit passes when the held-out blocks confirm it, and one
 // that the held-out blocks contradict (z <= 0) does not. On two sets of
 // 240 randomised runs of static maps and plain gains (docs/method.md),
