@@ -24,6 +24,15 @@
 #include "core/diagnosis_table.hpp"
 
 namespace mpm::diagnosis {
+
+const std::vector<FieldRow<Settings>>& Settings::fields() {
+  static const std::vector<FieldRow<Settings>> rows = {
+      {"alpha", [](Settings& s) { return &s.alpha; }, {.min = 0.0, .max = 0.5, .min_open = true, .max_open = true},
+       "family-wise false-alarm level: a matched record's chance of any finding"},
+  };
+  return rows;
+}
+
 namespace {
 
 bool overlaps(const std::set<std::pair<std::size_t, long>>& used, const Finding& f) {

@@ -60,6 +60,7 @@
 
 #include "core/diagnosis_physics.hpp"
 #include "core/diagnosis_signal.hpp"
+#include "core/field_table.hpp"
 #include "core/transfer_function.hpp"
 
 namespace mpm::diagnosis {
@@ -83,6 +84,10 @@ struct Settings {
   int max_extra_delay = 15;     // dead-time search range (samples)
   bool verbose = false;         // report every candidate through the progress callback
   std::size_t threads = 1;      // hypothesis generators run on this many threads (same result for any)
+
+  // The settings an engineer sets (`mpm diagnose --alpha`); the others are
+  // the method's.
+  static const std::vector<FieldRow<Settings>>& fields();
 };
 
 struct Problem {

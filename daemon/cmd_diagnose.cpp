@@ -21,6 +21,7 @@
 #include "daemon/limit_flags.hpp"
 #include "daemon/offline.hpp"
 #include "daemon/plant_writer.hpp"
+#include "daemon/setting_flags.hpp"
 #include "daemon/report_html.hpp"
 #include "daemon/series_allocator.hpp"
 
@@ -45,9 +46,11 @@ constexpr const char* kUsage =
     "                    applied, each change commented (never the input plant file)\n"
     "  --html REPORT.html  also write a self-contained HTML report (plots, fit %)\n"
     "  --quiet           no progress lines on standard error\n"
-    "  --verbose         also list every hypothesis tried, with its statistics\n"
-    MPM_LIMIT_FLAGS_USAGE
-    "  --help            this text\n";
+    "  --verbose         also list every hypothesis tried, with its statistics\n";
+constexpr const char* kUsageTail = MPM_LIMIT_FLAGS_USAGE "  --help            this text\n";
+
+// --alpha: the settings an engineer sets, from their table.
+const std::vector<FieldRow<diagnosis::Settings>>& setting_rows() { return diagnosis::Settings::fields(); }
 
 bool g_quiet = false;
 void progress(const char* message) {
@@ -94,9 +97,9 @@ std::string finding_json(const PlantModel& plant, const diagnosis::Finding& f) {
 }
 
 std::string report_json(const PlantModel& plant, std::size_t samples, const GrangerMonitor& m,
-                        const RecordVerdict& verdict, const diagnosis::Result& r) {
+                        const RecordVerdict& verdict, const diagnosis::Result& r, double alpha) {
   std::ostringstream o;
-  o << "{\n  \"schema\": \"mpm.diagnosis/1\",\n  \"samples\": " << samples
+  o << "{\n  \"schema\": \"mpm.diagnosis/1\",\n  \"samples\": " << samples << ",\n  \"alpha\": " << number(alpha)
     << ",\n  \"mismatch\": " << (r.mismatch ? "true" : "false") << ",\n  \"loops\": [\n";
   for (std::size_t j = 0; j < plant.n_outputs(); ++j) {
     bool loop_mismatch = verdict.loop_mismatch[j];
@@ -152,8 +155,12 @@ void write_products(const Args& args, const std::string& plant_path, const std::
 // --- Problem set-up ----------------------------------------------------------
 
 int run(int argc, char** argv) {
-  return run_command("mpm diagnose", kUsage, argc, argv, with_limit_flags({"plant", "data", "json", "write-plant", "html", "channel"}), {"quiet", "verbose"}, [&](const Args& args) {
+  static const std::string usage = kUsage + flags_usage(setting_rows(), true) + kUsageTail;
+  const auto valued = with_limit_flags(with_flags(setting_rows(), {"plant", "data", "json", "write-plant", "html", "channel"}));
+  return run_command("mpm diagnose", usage.c_str(), argc, argv, valued, {"quiet", "verbose"}, [&](const Args& args) {
     g_quiet = args.flag("quiet");
+    diagnosis::Settings settings;
+    apply_flags(args, setting_rows(), settings);
     keep_freed_columns_in_heap();
     const std::string plant_path = args.required("plant");
     const std::string data_path = args.required("data");
@@ -168,7 +175,8 @@ int run(int argc, char** argv) {
         plant, std::move(rec),
         {.verbose = args.flag("verbose"),
          .progress = g_quiet ? nullptr : &progress,
-         .on_sample = args.get("html") ? trace.callback() : PartSampleCallback{}});
+         .on_sample = args.get("html") ? trace.callback() : PartSampleCallback{},
+         .alpha = settings.alpha});
     // A header-only or all-NaN record leaves every statistic at its prior
     // (F = 0, p = 1): that is no evidence of a match, so say so instead of
     // printing "mismatch": false.
@@ -182,7 +190,7 @@ int run(int argc, char** argv) {
       return kExitUndecided;
     }
 
-    const std::string json = report_json(plant, d.samples, d.monitor, d.verdict, d.result);
+    const std::string json = report_json(plant, d.samples, d.monitor, d.verdict, d.result, settings.alpha);
     if (const auto out = args.get("json"))
       config::write_output_file(*out, json);
     else

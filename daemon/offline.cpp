@@ -138,13 +138,14 @@ RecordDiagnosis diagnose_record(const PlantModel& plant, config::Recording&& rec
   if (options.progress) options.progress("residuals computed; running the Granger monitor over the record");
   MonitorSettings settings;
   settings.forgetting = kRecordForgetting;
+  settings.false_alarm = options.alpha;
   RecordDiagnosis r{.samples = rec.samples(),
                     .monitor = monitor_record(plant, series, settings, replay_threads(plant.n_outputs()), false,
                                               options.on_sample)};
   // Family-wise, and at a tenth of the structured tests' level: the
   // monitor's verdict only adds a mismatch no hypothesis explains (`other`),
   // so a healthy record is reported matched with probability about
-  // 1 - 1.1 false_alarm, not 1 - 2 false_alarm. The structured tests are the
+  // 1 - 1.1 alpha, not 1 - 2 alpha. The structured tests are the
   // stronger detector: on the randomised benchmark the monitor flagged no
   // mismatch they all missed in 740 runs, and 4 of 1800 runs without one.
   r.verdict = record_verdict(r.monitor, record_test_count(r.monitor) / kUnexplainedShare);
@@ -160,6 +161,7 @@ RecordDiagnosis diagnose_record(const PlantModel& plant, config::Recording&& rec
   series = ResidualSeries{};
   diagnosis::Settings dsettings;
   dsettings.verbose = options.verbose;
+  dsettings.alpha = options.alpha;
   dsettings.threads = replay_threads(std::thread::hardware_concurrency());
   r.result = diagnosis::diagnose(r.problem, dsettings, options.progress);
   if (r.verdict.diverging) r.result.notes.push_back("the monitor finds a diverging loop: its statistics are not trusted");

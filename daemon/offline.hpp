@@ -101,6 +101,9 @@ struct RecordDiagnosisOptions {
   bool verbose = false;                      // every hypothesis' statistics to `progress`
   diagnosis::Progress progress = nullptr;    // progress lines (may be empty)
   PartSampleCallback on_sample;              // the monitor after each sample (the HTML report's trace)
+  // Family-wise false-alarm level of the whole diagnosis: the structured
+  // tests' level, and the monitor's record verdict at kUnexplainedShare of it.
+  double alpha = diagnosis::Settings{}.alpha;
 };
 
 // The share of the false-alarm level that `mpm diagnose` gives the
@@ -110,7 +113,7 @@ inline constexpr double kUnexplainedShare = 0.1;
 struct RecordDiagnosis {
   std::size_t samples = 0;  // rows of the recording
   GrangerMonitor monitor;
-  RecordVerdict verdict{};  // at kUnexplainedShare of the monitor's false_alarm, family-wise
+  RecordVerdict verdict{};  // at kUnexplainedShare of alpha, family-wise
   // Samples the tests need; with fewer usable (every input and output finite,
   // after the model settles) the record cannot be decided and no hypothesis
   // is fitted (problem and result stay empty).

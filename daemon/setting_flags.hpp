@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdio>
 #include <set>
 #include <string>
 #include <vector>
@@ -52,16 +53,27 @@ void apply_flags(const Args& args, const std::vector<FieldRow<S>>& rows, S& s) {
   }
 }
 
-// One usage line per row: "  --forgetting V  RLS forgetting factor ... (in (0.9, 1])".
+// One usage line per row: "  --forgetting V  RLS forgetting factor ... (in (0.9, 1])", with
+// "; default 0.999" before the ")" when asked.
 template <class S>
-std::string flags_usage(const std::vector<FieldRow<S>>& rows) {
+std::string flags_usage(const std::vector<FieldRow<S>>& rows, bool with_defaults = false) {
+  const S defaults{};
   std::string out;
   for (const FieldRow<S>& row : rows) {
     out += "  --" + flag_of(row) + " V  " + row.help;
     if (row.false_word) {
       out += std::string(" (") + row.false_word + " or " + row.true_word + ")";
     } else if (!std::isinf(row.range.min) || !std::isinf(row.range.max)) {
-      out += " (" + row.range.describe(row.word) + ")";
+      out += " (" + row.range.describe(row.word);
+      // The default is the struct's member initialiser, never written twice
+      // (not for a command whose defaults differ from the struct's, as
+      // `mpm monitor`'s forgetting 1 over the whole record).
+      if (const double d = number_of(row.get(defaults)); with_defaults && !std::isnan(d)) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%g", d);
+        out += std::string("; default ") + text;
+      }
+      out += ")";
     }
     out += '\n';
   }

@@ -4,7 +4,7 @@ every physics word the simulator can make, on random channels, magnitudes and
 seeds, scored as a confusion matrix by word.
 
 usage: scripts/generalisation_bench.py [--mpm build/daemon/mpm] [--runs 200] [--jobs 1] [--seed 1] [--random-fraction 0.5]
-                                       [--out bench.json] [--words gain,deadband] [--keep DIR]
+                                       [--out bench.json] [--words gain,deadband] [--keep DIR] [--alpha A]
 
 Each run draws a plant (Wood-Berry, the 3x3, the nonlinear quadruple tank, or
 a random stable plant: 2-4 inputs and outputs, first- and second-order
@@ -406,7 +406,8 @@ def diagnose(args, index, word, key, plant, run, truth, desc, sim_seed, ratio):
         shutil.copy(plant, os.path.join(kept, "plant.yaml"))
         shutil.copy(run, os.path.join(kept, "run.csv"))
     out = run + ".json"
-    r = subprocess.run([args.mpm, "diagnose", "--quiet", "--plant", plant, "--data", run, "--json", out],
+    level = [] if args.alpha is None else ["--alpha", repr(args.alpha)]
+    r = subprocess.run([args.mpm, "diagnose", "--quiet", "--plant", plant, "--data", run, "--json", out] + level,
                        capture_output=True, text=True)
     if r.returncode != 0:
         return {"index": index, "word": word, "plant": key, "desc": desc, "error": r.stderr.strip()[-300:]}
@@ -529,6 +530,8 @@ def main():
                     help="share of runs on a random plant (words the simulator can edit on any plant)")
     ap.add_argument("--out", default="", help="write the runs and the score as JSON here (never overwritten)")
     ap.add_argument("--verbose", action="store_true", help="one line per run")
+    ap.add_argument("--alpha", type=float, default=None,
+                    help="mpm diagnose's family-wise false-alarm level (default: mpm's own)")
     ap.add_argument("--keep", default="", help="copy each run's plant file and recording to KEEP/runNNN/ (to rerun one)")
     args = ap.parse_args()
     args.words = [w for w in args.words.split(",") if w]
@@ -552,7 +555,7 @@ def main():
         with open(args.out, "w") as f:
             json.dump({"args": {"runs": args.runs, "seed": args.seed, "words": args.words,
                                 "none_fraction": args.none_fraction,
-                                "random_fraction": args.random_fraction}, "score": s, "runs": results}, f, indent=1)
+                                "random_fraction": args.random_fraction, "alpha": args.alpha}, "score": s, "runs": results}, f, indent=1)
     return 0
 
 

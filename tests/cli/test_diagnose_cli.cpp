@@ -67,6 +67,7 @@ TEST(DiagnoseCli, ReportKeepsTheContract) {
   const std::string r = diagnose_scenario("wood-berry-g12-dead-time", 21);
   EXPECT_NE(r.find("\"schema\": \"mpm.diagnosis/1\""), std::string::npos);
   EXPECT_NE(r.find("\"samples\": 3000"), std::string::npos);
+  EXPECT_NE(r.find("\"alpha\": 0.001,"), std::string::npos) << "the default level, stated";
   for (const char* y : {"y1", "y2"}) EXPECT_NE(r.find("{\"output\": \"" + std::string(y) + "\", \"mismatch\""), std::string::npos);
   for (const char* key : {"\"granger\": [", "\"gamma\": [", "\"findings\": [", "\"residual_variance\"",
                           "\"holdout_variance_after\"", "\"p_value\""})
@@ -286,6 +287,17 @@ TEST_F(DiagnoseOutput, JsonEqualToDataIsRefusedAndTheRecordingKept) {
   EXPECT_EQ(read_file(csv_), before);
   const auto p = diagnose(csv_, " --json " + kWoodBerry);
   EXPECT_EQ(p.exit_code, 1) << "the plant file is an input too";
+}
+
+TEST_F(DiagnoseOutput, AlphaIsTheReportsLevelAndOutOfRangeIsAUsageError) {
+  const auto r = diagnose(csv_, " --alpha 0.05");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"alpha\": 0.05,"), std::string::npos) << r.out;
+  for (const char* bad : {"0", "0.5", "-0.01", "1e-400x", "level"}) {
+    const auto b = diagnose(csv_, std::string(" --alpha ") + bad);
+    EXPECT_EQ(b.exit_code, 2) << bad;
+    EXPECT_NE(b.err.find("--alpha"), std::string::npos) << bad << ": " << b.err;
+  }
 }
 
 TEST_F(DiagnoseOutput, WriteErrorGivesNonZeroExit) {

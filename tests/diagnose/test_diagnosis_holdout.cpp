@@ -21,33 +21,8 @@ namespace {
 using mpm::DiscreteTf;
 namespace dg = mpm::diagnosis;
 
-// G(q) = 0.2 q^-1 / (1 - 0.8 q^-1) applied to u.
-Eigen::VectorXd channel(const Eigen::VectorXd& u) {
-  Eigen::VectorXd y(u.size());
-  double s = 0.0;
-  for (Eigen::Index k = 0; k < u.size(); ++k) {
-    y(k) = s;
-    s = 0.8 * s + 0.2 * u(k);
-  }
-  return y;
-}
-
-// An input that steps to a level drawn uniformly in [-amplitude, amplitude]
-// every 5 to 30 samples.
-Eigen::VectorXd random_steps(std::mt19937& rng, Eigen::Index n, double amplitude) {
-  std::uniform_int_distribution<int> hold(5, 30);
-  std::uniform_real_distribution<double> level(-amplitude, amplitude);
-  Eigen::VectorXd u(n);
-  double v = 0.0;
-  for (Eigen::Index k = 0, next = 0; k < n; ++k) {
-    if (k == next) {
-      v = level(rng);
-      next = k + hold(rng);
-    }
-    u(k) = v;
-  }
-  return u;
-}
+using mpm::test::first_order_channel;
+using mpm::test::random_steps;
 
 // u steps within [-1, 1], except once, from `episode` for 80 samples, at
 // 2.5; the plant's actuator stops at 1.2, which only that episode reaches.
@@ -61,11 +36,11 @@ dg::Problem episode_problem(unsigned seed, Eigen::Index episode) {
     if (k >= episode && k < episode + 80) u(k) = 2.5;
     plant_u(k) = std::min(u(k), 1.2);
   }
-  Eigen::VectorXd residual = channel(plant_u) - channel(u);
+  Eigen::VectorXd residual = first_order_channel(plant_u) - first_order_channel(u);
   for (Eigen::Index k = 0; k < n; ++k) residual(k) += noise(rng);
   Eigen::MatrixXd du(n, 1);
   du.col(0) = u;
-  return mpm::test::one_output_problem({"u"}, std::move(du), std::move(residual), {DiscreteTf{{0.2}, {1.0, -0.8}, 1}},
+  return mpm::test::one_output_problem({"u"}, std::move(du), std::move(residual), {mpm::test::first_order_model()},
                                       DiscreteTf{{1.0}, {1.0}, 0}, 0.05 * 0.05);
 }
 
@@ -111,7 +86,7 @@ dg::Problem noise_problem(unsigned seed) {
   }
   Eigen::MatrixXd du(n, 1);
   du.col(0) = u;
-  return mpm::test::one_output_problem({"u"}, std::move(du), std::move(residual), {DiscreteTf{{0.2}, {1.0, -0.8}, 1}},
+  return mpm::test::one_output_problem({"u"}, std::move(du), std::move(residual), {mpm::test::first_order_model()},
                                       DiscreteTf{{1.0}, {1.0, -0.8}, 0}, 0.05 * 0.05);
 }
 

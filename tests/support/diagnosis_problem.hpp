@@ -3,6 +3,7 @@
 #pragma once
 
 #include <optional>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -29,6 +30,38 @@ inline diagnosis::Problem one_output_problem(std::vector<std::string> inputs, Ei
   p.monitor_flag = {true};
   p.monitor_located = {{0}};
   return p;
+}
+
+// G(q) = 0.2 q^-1 / (1 - 0.8 q^-1) applied to u: the first-order channel
+// of the synthetic problems (unit gain, one sample of delay).
+inline Eigen::VectorXd first_order_channel(const Eigen::VectorXd& u) {
+  Eigen::VectorXd y(u.size());
+  double s = 0.0;
+  for (Eigen::Index k = 0; k < u.size(); ++k) {
+    y(k) = s;
+    s = 0.8 * s + 0.2 * u(k);
+  }
+  return y;
+}
+
+// The model of first_order_channel().
+inline DiscreteTf first_order_model() { return DiscreteTf{{0.2}, {1.0, -0.8}, 1}; }
+
+// An input that steps to a level drawn uniformly in [-amplitude, amplitude]
+// every 5 to 30 samples.
+inline Eigen::VectorXd random_steps(std::mt19937& rng, Eigen::Index n, double amplitude) {
+  std::uniform_int_distribution<int> hold(5, 30);
+  std::uniform_real_distribution<double> level(-amplitude, amplitude);
+  Eigen::VectorXd u(n);
+  double v = 0.0;
+  for (Eigen::Index k = 0, next = 0; k < n; ++k) {
+    if (k == next) {
+      v = level(rng);
+      next = k + hold(rng);
+    }
+    u(k) = v;
+  }
+  return u;
 }
 
 }  // namespace mpm::test
