@@ -28,7 +28,7 @@ namespace mpm::diagnosis {
 const std::vector<FieldRow<Settings>>& Settings::fields() {
   static const std::vector<FieldRow<Settings>> rows = {
       {"alpha", [](Settings& s) { return &s.alpha; }, {.min = 0.0, .max = 0.5, .min_open = true, .max_open = true},
-       "false-alarm level of each look (process, disturbance model): a healthy record gets a finding at most 2.1 x as often"},
+       "false-alarm level of each look: the process hypotheses, a changed disturbance model"},
   };
   return rows;
 }

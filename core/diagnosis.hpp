@@ -68,9 +68,10 @@ namespace mpm::diagnosis {
 struct Settings {
   // Family-wise false-alarm level of each of the diagnosis' looks: the
   // process rounds, and the changed disturbance model where no finding
-  // explains an output. With the monitor's verdict at a tenth of it
-  // (`mpm diagnose`), a healthy record gets a finding with probability at
-  // most 2.1 alpha (union bound; measured 0.22 % at 0.001, docs/method.md).
+  // explains an output. With the monitor's verdict beside them, `mpm
+  // diagnose` bounds a healthy record's chance of a finding by
+  // healthy_finding_bound(alpha) (daemon/offline.hpp; docs/method.md
+  // measures it).
   double alpha = 1e-3;
   double holdout_level = 0.05;  // level of the held-out confirmation (holdout_z is its quantile)
   double holdout_z = 1.645;     // one-sided 5 % paired test on the held-out part

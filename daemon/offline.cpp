@@ -144,8 +144,9 @@ RecordDiagnosis diagnose_record(const PlantModel& plant, config::Recording&& rec
                                               options.on_sample)};
   // Family-wise, and at a tenth of the structured tests' level: the
   // monitor's verdict only adds a mismatch no hypothesis explains (`other`),
-  // so a healthy record is reported matched with probability about
-  // 1 - 1.1 alpha, not 1 - 2 alpha. The structured tests are the
+  // so it adds a tenth of alpha to the two structured looks' (the process
+  // rounds, the disturbance model) instead of a whole one
+  // (healthy_finding_bound()). The structured tests are the
   // stronger detector: on the randomised benchmark the monitor flagged no
   // mismatch they all missed in 740 runs, and 4 of 1800 runs without one.
   r.verdict = record_verdict(r.monitor, record_test_count(r.monitor) / kUnexplainedShare);

@@ -110,6 +110,11 @@ struct RecordDiagnosisOptions {
 // monitor's record verdict, beside the structured tests' full level.
 inline constexpr double kUnexplainedShare = 0.1;
 
+// The most often a record without mismatch gets a finding at level alpha:
+// the process rounds and the disturbance-model look spend alpha each, the
+// monitor's verdict kUnexplainedShare of it (union bound).
+inline double healthy_finding_bound(double alpha) { return (2.0 + kUnexplainedShare) * alpha; }
+
 struct RecordDiagnosis {
   std::size_t samples = 0;  // rows of the recording
   GrangerMonitor monitor;

@@ -60,6 +60,7 @@ struct ReportInputs {
   const diagnosis::Result& result;
   std::string plant_path, data_path;
   const DetectorTrace* trace = nullptr;  // the detector section is left out without it
+  double alpha = diagnosis::Settings{}.alpha;  // the level the diagnosis was made at
 };
 
 // Where the dygraphs script is read from: $MPM_DYGRAPHS_JS when set, else
