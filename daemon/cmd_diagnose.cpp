@@ -21,9 +21,9 @@
 #include "daemon/limit_flags.hpp"
 #include "daemon/offline.hpp"
 #include "daemon/plant_writer.hpp"
-#include "daemon/setting_flags.hpp"
 #include "daemon/report_html.hpp"
 #include "daemon/series_allocator.hpp"
+#include "daemon/setting_flags.hpp"
 
 namespace mpm {
 namespace {

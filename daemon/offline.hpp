@@ -101,8 +101,8 @@ struct RecordDiagnosisOptions {
   bool verbose = false;                      // every hypothesis' statistics to `progress`
   diagnosis::Progress progress = nullptr;    // progress lines (may be empty)
   PartSampleCallback on_sample;              // the monitor after each sample (the HTML report's trace)
-  // Family-wise false-alarm level of the whole diagnosis: the structured
-  // tests' level, and the monitor's record verdict at kUnexplainedShare of it.
+  // The diagnosis' false-alarm level per look (diagnosis::Settings::alpha),
+  // and the monitor's record verdict at kUnexplainedShare of it.
   double alpha = diagnosis::Settings{}.alpha;
 };
 

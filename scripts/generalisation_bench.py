@@ -531,7 +531,7 @@ def main():
     ap.add_argument("--out", default="", help="write the runs and the score as JSON here (never overwritten)")
     ap.add_argument("--verbose", action="store_true", help="one line per run")
     ap.add_argument("--alpha", type=float, default=None,
-                    help="mpm diagnose's family-wise false-alarm level (default: mpm's own)")
+                    help="mpm diagnose --alpha: its false-alarm level per look (default: mpm's own)")
     ap.add_argument("--keep", default="", help="copy each run's plant file and recording to KEEP/runNNN/ (to rerun one)")
     args = ap.parse_args()
     args.words = [w for w in args.words.split(",") if w]
