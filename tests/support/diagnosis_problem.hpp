@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/diagnosis.hpp"
+#include "core/diagnosis_signal.hpp"
 
 namespace mpm::test {
 
@@ -32,20 +33,12 @@ inline diagnosis::Problem one_output_problem(std::vector<std::string> inputs, Ei
   return p;
 }
 
-// G(q) = 0.2 q^-1 / (1 - 0.8 q^-1) applied to u: the first-order channel
-// of the synthetic problems (unit gain, one sample of delay).
-inline Eigen::VectorXd first_order_channel(const Eigen::VectorXd& u) {
-  Eigen::VectorXd y(u.size());
-  double s = 0.0;
-  for (Eigen::Index k = 0; k < u.size(); ++k) {
-    y(k) = s;
-    s = 0.8 * s + 0.2 * u(k);
-  }
-  return y;
-}
-
-// The model of first_order_channel().
+// G(q) = 0.2 q^-1 / (1 - 0.8 q^-1): the first-order channel of the
+// synthetic problems (unit gain, one sample of delay), and its response to u.
 inline DiscreteTf first_order_model() { return DiscreteTf{{0.2}, {1.0, -0.8}, 1}; }
+inline Eigen::VectorXd first_order_channel(const Eigen::VectorXd& u) {
+  return diagnosis::simulate(first_order_model(), u);
+}
 
 // An input that steps to a level drawn uniformly in [-amplitude, amplitude]
 // every 5 to 30 samples.
