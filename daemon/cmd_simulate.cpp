@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -22,7 +23,8 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: mpm simulate --scenario NAME [--plant PLANT.yaml] [--samples N] [--seed S] [--edit SPEC]...\n"
-    "                    [--move-weight-scale X] --out RUN.csv\n"
+    "                    [--move-weight-scale X] [--reference-out REF.csv [--reference-plant MODEL.yaml]]\n"
+    "                    --out RUN.csv\n"
     "       mpm simulate --list\n"
     "  Runs the closed loop of the scenario (DMC with IMC bias correction on the plant file's\n"
     "  model; the plant differs from it as the scenario says, plus any --edit) and writes t,\n"
@@ -51,6 +53,13 @@ constexpr const char* kUsage =
     "                   below 1 a tighter controller, whose inputs answer the noise more (more\n"
     "                   excitation), above 1 a calmer one\n"
     "  --out FILE       where to write the recording CSV\n"
+    "  --reference-out FILE   also write t and the outputs the sensors would have read had the\n"
+    "                   plant been the reference model (unedited, linear), fed the same inputs,\n"
+    "                   with the same disturbance innovations through the reference's own noise\n"
+    "                   filters. The recording's outputs minus these are what the model leaves out,\n"
+    "                   on this run (a simulation-only oracle of a mismatch's size)\n"
+    "  --reference-plant FILE  the reference model (default: the nominal model); same inputs and\n"
+    "                   outputs as it, e.g. the plant file a diagnosis will be given\n"
     "  --list           list the scenarios and exit\n";
 
 // The scenario's move weights (empty: all 1) times `scale`.
@@ -113,7 +122,9 @@ int run_simulate(int argc, char** argv) {
   std::optional<std::string> plant_path;
   double move_weight_scale = 1.0;
   return run_command("mpm simulate", kUsage, argc, argv,
-                     {"plant", "scenario", "samples", "seed", "out", "edit", "move-weight-scale"}, {"list"},
+                     {"plant", "scenario", "samples", "seed", "out", "edit", "move-weight-scale", "reference-out",
+                      "reference-plant"},
+                     {"list"},
                      [&](const Args& args) {
     if (args.flag("list")) {
       list_scenarios();
@@ -135,7 +146,21 @@ int run_simulate(int argc, char** argv) {
     const sim::Scenario& scenario = *found;
     sim::ResolvedPlant plant = plant_path ? sim::ResolvedPlant{config::load_plant(*plant_path), *plant_path}
                                           : sim::default_plant(scenario);
-    config::refuse_input_as_output(out_path, {plant.source});
+    const std::optional<std::string> reference_out = args.get("reference-out");
+    const std::optional<std::string> reference_path = args.get("reference-plant");
+    if (reference_path && !reference_out) throw UsageError("--reference-plant needs --reference-out");
+    if (reference_out && *reference_out == out_path) throw UsageError("--reference-out: the same file as --out");
+    std::optional<PlantModel> reference;
+    if (reference_out) {
+      reference = reference_path ? config::load_plant(*reference_path) : plant.model;
+      if (reference->inputs != plant.model.inputs || reference->outputs != plant.model.outputs)
+        throw UsageError("--reference-plant " + *reference_path + ": its inputs and outputs differ from the plant " +
+                         plant.source + "'s");
+    }
+    std::vector<std::string> read_files{plant.source};
+    if (reference_path) read_files.push_back(*reference_path);
+    config::refuse_input_as_output(out_path, read_files);
+    if (reference_out) config::refuse_input_as_output(*reference_out, read_files);
     std::vector<sim::EditSpec> edits;
     sim::LoopConfig loop_config = sim::scenario_loop(scenario, plant.model);
     try {
@@ -148,16 +173,21 @@ int run_simulate(int argc, char** argv) {
     if (move_weight_scale != 1.0) what += " (move weights x " + format_number(move_weight_scale) + ")";
     sim::ClosedLoop loop = [&] {
       try {
-        return sim::ClosedLoop(plant.model, loop_config, seed);
+        return sim::ClosedLoop(plant.model, loop_config, seed, reference ? &*reference : nullptr);
       } catch (const std::invalid_argument& e) {
         throw std::runtime_error("scenario " + what + " does not fit the plant " + plant.source + ": " + e.what());
       }
     }();
-    const config::Recording rec = sim::simulate(loop, samples, out_path);
+    config::Recording reference_rec;
+    const config::Recording rec = sim::simulate(loop, samples, out_path, reference ? &reference_rec : nullptr);
     config::write_recording(out_path, rec);
+    if (reference_out) config::write_recording(*reference_out, reference_rec);
     std::printf("wrote %s: %zu samples of %s (plant %s, seed %llu); input limits active at %zu samples\n",
                 out_path.c_str(), samples, what.c_str(), plant.source.c_str(),
                 static_cast<unsigned long long>(seed), loop.controller().constrained_samples());
+    if (reference_out)
+      std::printf("wrote %s: what the reference model %s would have measured on this run\n", reference_out->c_str(),
+                  reference_path ? reference_path->c_str() : plant.source.c_str());
     config::write_stdout("");  // flushes; a failed write of the line above is an error
     return 0;
   });

@@ -32,7 +32,8 @@ std::vector<std::string> recording_columns(const PlantModel& m, const LoopConfig
 
 }  // namespace
 
-ClosedLoop::ClosedLoop(const PlantModel& model, const LoopConfig& config, std::uint64_t seed)
+ClosedLoop::ClosedLoop(const PlantModel& model, const LoopConfig& config, std::uint64_t seed,
+                       const PlantModel* reference)
     : model_(model),
       model_op_(model_operating_point(model)),
       plant_op_(plant_operating_point(model, config.plant)),
@@ -65,6 +66,17 @@ ClosedLoop::ClosedLoop(const PlantModel& model, const LoopConfig& config, std::u
   sample_.y = y_abs_;
   sample_.r = r_abs_;
   sample_.extra = extra_abs_;
+  if (reference) {
+    if (reference->inputs != model.inputs || reference->outputs != model.outputs)
+      throw std::invalid_argument("the reference model's inputs and outputs differ from the model's");
+    const PlantSpec unedited;
+    reference_.emplace(Reference{plant_operating_point(*reference, unedited), build_plant(*reference, unedited),
+                                 NoiseSource(noise_channels(*reference, config.default_noise_variance), seed,
+                                             config.noise_scale),
+                                 std::vector<double>(no), std::vector<double>(no), std::vector<double>(ni),
+                                 std::vector<double>(no)});
+    sample_.reference = reference_->y_abs;
+  }
   k_ = -config.warmup;
   while (k_ < 0) step();
 }
@@ -75,6 +87,12 @@ const LoopSample& ClosedLoop::step() noexcept {
   setpoints_.at(k_, r_dev_.data());
   noise_.draw(d_.data());
   plant_.measure(d_.data(), y_plant_.data());
+  if (reference_) {
+    Reference& ref = *reference_;
+    ref.noise.draw(ref.d.data());
+    ref.plant.measure(ref.d.data(), ref.y_dev.data());
+    for (std::size_t j = 0; j < ref.y_abs.size(); ++j) ref.y_abs[j] = ref.op.outputs[j] + ref.y_dev[j];
+  }
   for (std::size_t j = 0; j < y_abs_.size(); ++j) {
     y_abs_[j] = plant_op_.outputs[j] + y_plant_[j];
     y_ctrl_[j] = y_abs_[j] - model_op_.outputs[j];
@@ -91,6 +109,11 @@ const LoopSample& ClosedLoop::step() noexcept {
     extra_abs_[i] = extra_op_[x] + extra_dev_[x];
   }
   plant_.apply(u_plant_.data(), extra_dev_.empty() ? nullptr : extra_dev_.data());
+  if (reference_) {
+    Reference& ref = *reference_;
+    for (std::size_t l = 0; l < ref.u_dev.size(); ++l) ref.u_dev[l] = u_abs_[l] - ref.op.inputs[l];
+    ref.plant.apply(ref.u_dev.data(), nullptr);
+  }
   sample_.k = k_;
   sample_.t = static_cast<double>(k_) * model_.sample_time;
   ++k_;
@@ -102,16 +125,31 @@ void ClosedLoop::fill_row(const LoopSample& s, double* row) const noexcept {
   for (auto* part : {&s.u, &s.y, &s.r, &s.extra}) row = std::copy(part->begin(), part->end(), row);
 }
 
-config::Recording simulate(ClosedLoop& loop, std::size_t samples, const std::string& recording_name) {
+config::Recording simulate(ClosedLoop& loop, std::size_t samples, const std::string& recording_name,
+                           config::Recording* reference) {
+  if (reference && !loop.has_reference()) throw std::invalid_argument("the loop has no reference model");
   config::Recording rec;
   rec.source = recording_name;
   rec.names = loop.column_names();
   rec.data.resize(static_cast<Eigen::Index>(samples), static_cast<Eigen::Index>(rec.names.size()));
+  if (reference) {
+    reference->source = recording_name + " (reference model)";
+    reference->names = {"t"};
+    const auto& outputs = loop.model().outputs;
+    reference->names.insert(reference->names.end(), outputs.begin(), outputs.end());
+    reference->data.resize(static_cast<Eigen::Index>(samples), static_cast<Eigen::Index>(reference->names.size()));
+  }
   std::vector<double> row(rec.names.size());
   for (std::size_t k = 0; k < samples; ++k) {
-    loop.fill_row(loop.step(), row.data());
-    for (std::size_t c = 0; c < row.size(); ++c)
-      rec.data(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(c)) = row[c];
+    const LoopSample& s = loop.step();
+    loop.fill_row(s, row.data());
+    const auto r = static_cast<Eigen::Index>(k);
+    for (std::size_t c = 0; c < row.size(); ++c) rec.data(r, static_cast<Eigen::Index>(c)) = row[c];
+    if (reference) {
+      reference->data(r, 0) = s.t;
+      for (std::size_t j = 0; j < s.reference.size(); ++j)
+        reference->data(r, static_cast<Eigen::Index>(j + 1)) = s.reference[j];
+    }
   }
   return rec;
 }

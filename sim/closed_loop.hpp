@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -38,19 +39,31 @@ struct LoopSample {
   long k = 0;
   double t = 0.0;
   std::span<const double> u, y, r, extra;  // extra: the recorded extra inputs
+  std::span<const double> reference;        // the reference model's outputs; empty without one
 };
 
 class ClosedLoop {
  public:
   // Setup (allocates, runs the warm-up). Throws std::invalid_argument with a
   // message naming what does not fit.
-  ClosedLoop(const PlantModel& model, const LoopConfig& config, std::uint64_t seed);
+  //
+  // With a `reference` model (same input and output names), every sample also
+  // carries what the sensors would have read had the plant been that model:
+  // its linear channels, unedited, fed the loop's inputs, plus its own noise
+  // filters driven by the same white innovations a_j. The measured outputs
+  // minus these are the contribution of everything the reference leaves out,
+  // on the recorded trajectory: known only in simulation, it is the
+  // benchmark's oracle of how visible a mismatch is (scripts/
+  // generalisation_bench.py). The reference does not act on the loop.
+  ClosedLoop(const PlantModel& model, const LoopConfig& config, std::uint64_t seed,
+             const PlantModel* reference = nullptr);
 
   // Real-time safe: measure y(k), choose u(k), apply it.
   const LoopSample& step() noexcept;
 
   // Recording columns: t, inputs, outputs, r_<output>, recorded extra inputs.
   const std::vector<std::string>& column_names() const noexcept { return columns_; }
+  bool has_reference() const noexcept { return reference_.has_value(); }
   // Writes the sample's values in column order into row (column_names().size()).
   void fill_row(const LoopSample& s, double* row) const noexcept;
 
@@ -72,11 +85,21 @@ class ClosedLoop {
   std::vector<double> r_dev_, d_, y_plant_, y_ctrl_, u_ctrl_, u_plant_, extra_dev_;
   std::vector<double> u_abs_, y_abs_, r_abs_, extra_abs_;  // extra_abs_: recorded ones only
   std::vector<std::size_t> recorded_extra_;
+  struct Reference {
+    OperatingPoint op;
+    Plant plant;
+    NoiseSource noise;
+    std::vector<double> d, y_dev, u_dev, y_abs;
+  };
+  std::optional<Reference> reference_;
   LoopSample sample_;
   long k_ = 0;
 };
 
 // Runs `samples` steps of the loop into a Recording (source = recording_name).
-config::Recording simulate(ClosedLoop& loop, std::size_t samples, const std::string& recording_name = "simulation");
+// With `reference` (the loop must have a reference model), also collects t
+// and the reference's outputs, named as the model's, into it.
+config::Recording simulate(ClosedLoop& loop, std::size_t samples, const std::string& recording_name = "simulation",
+                           config::Recording* reference = nullptr);
 
 }  // namespace mpm::sim

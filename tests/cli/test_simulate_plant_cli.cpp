@@ -7,7 +7,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -101,6 +104,68 @@ TEST(SimulatePlantCli, EditChangesTheRunAndIsReported) {
                               "three-by-three.yaml --edit y4.u1.gain=2 --out " + tmp_path("bad.csv"));
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("unknown output 'y4' (outputs: y1, y2, y3)"), std::string::npos) << bad.err;
+}
+
+// Column `name` of a CSV text, as numbers.
+std::vector<double> csv_column(const std::string& csv, const std::string& name) {
+  std::vector<double> values;
+  const std::string head = header(csv);
+  std::size_t index = 0, at = 0;
+  for (std::size_t comma; (comma = head.find(',', at)) != std::string::npos && head.substr(at, comma - at) != name;
+       at = comma + 1)
+    ++index;
+  for (std::size_t row = csv.find('\n') + 1; row < csv.size(); row = csv.find('\n', row) + 1) {
+    const char* cell = csv.c_str() + row;
+    for (std::size_t c = 0; c < index; ++c) cell = std::strchr(cell, ',') + 1;
+    values.push_back(std::strtod(cell, nullptr));
+    if (csv.find('\n', row) == std::string::npos) break;
+  }
+  return values;
+}
+
+// --reference-out: what the reference model would have measured on the run.
+// The unedited model reads exactly the recording's outputs; an edit of y1 <- u1
+// shows on y1 alone.
+TEST(SimulatePlantCli, ReferenceOutIsWhatTheModelWouldHaveMeasured) {
+  const std::string plant = kConfig + "three-by-three.yaml";
+  for (const std::string edit : {"", "--edit y1.u1.gain=1.5"}) {
+    const std::string csv = tmp_path("ref_run.csv"), ref = tmp_path("ref_model.csv");
+    std::remove(csv.c_str());
+    std::remove(ref.c_str());
+    const CliRun r = simulate("--scenario plant-nominal --plant " + plant + " --samples 300 --seed 4 " + edit +
+                              " --out " + csv + " --reference-out " + ref);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("wrote " + ref + ": what the reference model " + plant), std::string::npos) << r.out;
+    const std::string run = read_file(csv), model = read_file(ref);
+    EXPECT_EQ(header(model), "t,y1,y2,y3");
+    EXPECT_EQ(csv_column(model, "t"), csv_column(run, "t"));
+    EXPECT_EQ(csv_column(model, "y2"), csv_column(run, "y2")) << edit;
+    EXPECT_EQ(csv_column(model, "y3"), csv_column(run, "y3")) << edit;
+    EXPECT_EQ(csv_column(model, "y1") == csv_column(run, "y1"), edit.empty()) << edit;
+    EXPECT_EQ(csv_column(model, "y1").size(), 300u);
+  }
+}
+
+TEST(SimulatePlantCli, ReferenceFlagsRefuseWhatCannotWork) {
+  const std::string base = "--scenario plant-nominal --plant " + kConfig + "three-by-three.yaml --samples 20 ";
+  const std::string csv = tmp_path("refused_run.csv"), ref = tmp_path("refused_ref.csv");
+  std::remove(ref.c_str());
+  for (const auto& [args, says] : std::initializer_list<std::pair<std::string, std::string>>{
+           {"--reference-plant " + kConfig + "three-by-three.yaml --out " + csv, "--reference-plant needs --reference-out"},
+           {"--out " + csv + " --reference-out " + csv, "--reference-out: the same file as --out"},
+           {"--out " + csv + " --reference-out " + ref + " --reference-plant " + kConfig + "wood-berry.yaml",
+            "its inputs and outputs differ"}}) {
+    const CliRun r = simulate(base + args);
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+    EXPECT_TRUE(read_file(ref).empty()) << args;
+  }
+  // An input file is never overwritten.
+  const std::string before = read_file(kConfig + "three-by-three.yaml");
+  const CliRun r = simulate(base + "--out " + csv + " --reference-out " + kConfig + "three-by-three.yaml");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("refusing to overwrite an input"), std::string::npos) << r.err;
+  EXPECT_EQ(read_file(kConfig + "three-by-three.yaml"), before);
 }
 
 // Mean |u(k) - u(k-1)| of the first input column (column 1 after t).

@@ -2,8 +2,11 @@
 // layout of formats.md in absolute units, and the paper's unstable G32 case.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
+#include <vector>
 
 #include "sim/closed_loop.hpp"
 #include "sim/scenarios.hpp"
@@ -76,6 +79,67 @@ TEST(ClosedLoop, RecordingHasTheFormatsColumnsAndBindsToItsPlant) {
   EXPECT_NEAR(back.data.col(7).mean(), 2.45, 0.3);  // around its operating value
   EXPECT_TRUE(back.data.isApprox(rec.data, 1e-15));
   std::remove(path.c_str());
+}
+
+// The reference model's outputs, recorded beside the loop's: (recording, reference).
+std::pair<config::Recording, config::Recording> record_with_reference(const char* name, const PlantModel& reference,
+                                                                      std::size_t n, long warmup) {
+  const Scenario& s = scenario(name);
+  LoopConfig c = s.loop;
+  c.warmup = warmup;
+  ClosedLoop loop(default_plant(s).model, c, 5, &reference);
+  config::Recording ref;
+  auto rec = simulate(loop, n, "run", &ref);
+  return {std::move(rec), std::move(ref)};
+}
+
+TEST(ClosedLoop, AReferenceThatIsThePlantReadsWhatItsSensorsRead) {
+  const Scenario& s = scenario("wood-berry-nominal");
+  const auto [rec, ref] = record_with_reference("wood-berry-nominal", default_plant(s).model, 800, s.loop.warmup);
+  EXPECT_EQ(ref.names, (std::vector<std::string>{"t", "y1", "y2"}));
+  EXPECT_TRUE(ref.data.col(0) == rec.data.col(0));
+  // The same innovations through the same filters, the same inputs through the same channels.
+  EXPECT_TRUE(ref.data.col(1) == rec.data.col(3));
+  EXPECT_TRUE(ref.data.col(2) == rec.data.col(4));
+  EXPECT_GT((rec.data.col(4).array() - rec.data.col(4).mean()).abs().maxCoeff(), 0.5);  // the loop moved
+}
+
+TEST(ClosedLoop, TheOutputsMinusTheReferenceAreWhatTheReferenceLeavesOut) {
+  // The plant is the full Wood-Berry model; the reference lacks y2 <- u1. The
+  // difference is then exactly that channel's response to the recorded u1
+  // (no warm-up, so that it starts from rest with the recording), and y1's is 0.
+  const Scenario& s = scenario("wood-berry-nominal");
+  const PlantModel full = default_plant(s).model;
+  PlantModel lacking = full, only = full;
+  std::erase_if(lacking.channels, [](const ChannelModel& c) { return c.output == 1 && c.input == 0; });
+  std::erase_if(only.channels, [](const ChannelModel& c) { return !(c.output == 1 && c.input == 0); });
+  ASSERT_EQ(lacking.channels.size() + 1, full.channels.size());
+  ASSERT_EQ(only.channels.size(), 1u);
+  const auto [rec, ref] = record_with_reference("wood-berry-nominal", lacking, 1500, 0);
+  Plant channel = testing::build(only);
+  const std::vector<double> no_disturbance(2, 0.0);
+  std::vector<double> y(2), u(2);
+  double largest = 0.0;
+  for (Eigen::Index k = 0; k < rec.data.rows(); ++k) {
+    channel.measure(no_disturbance.data(), y.data());
+    EXPECT_EQ(rec.data(k, 3), ref.data(k, 1)) << k;
+    EXPECT_NEAR(rec.data(k, 4) - ref.data(k, 2), y[1], 1e-9) << k;
+    largest = std::max(largest, std::abs(y[1]));
+    for (std::size_t l = 0; l < 2; ++l)
+      u[l] = rec.data(k, static_cast<Eigen::Index>(1 + l)) - full.operating_point->inputs[l];
+    channel.apply(u.data(), nullptr);
+  }
+  EXPECT_GT(largest, 0.5);  // the channel carried something
+}
+
+TEST(ClosedLoop, AReferenceWithOtherSignalsIsRefused) {
+  const Scenario& s = scenario("wood-berry-nominal");
+  PlantModel other = default_plant(s).model;
+  other.outputs[1] = "xD";
+  EXPECT_THROW(ClosedLoop(default_plant(s).model, s.loop, 1, &other), std::invalid_argument);
+  ClosedLoop without(default_plant(s).model, s.loop, 1);
+  config::Recording ref;
+  EXPECT_THROW(simulate(without, 10, "run", &ref), std::invalid_argument);
 }
 
 TEST(ClosedLoop, AnUnrecordedExtraInputActsButLeavesNoColumn) {
