@@ -488,6 +488,7 @@ def score(results):
     by_plant = defaultdict(Counter)  # per plant kind (random / fixed): physics right, true findings
     by_band = defaultdict(Counter)  # per visibility band (index into BANDS): true findings, detected, right
     conf_detectable = defaultdict(Counter)  # the confusion matrix of the detectable true findings
+    visible = Counter()  # runs whose every true finding is detectable: runs, detected, channel tp / fp / fn
     for r in results:
         if "error" in r:
             errors += 1
@@ -510,6 +511,13 @@ def score(results):
         tp += len(tset & fset)
         fp += len(fset - tset)
         fn += len(tset - fset)
+        seen = [finding_visibility(r, t) for t in r["truth"]]
+        if truth and all(v is not None and v >= DETECTABLE for v in seen):
+            visible["runs"] += 1
+            visible["detected"] += bool(r["mismatch"])
+            visible["tp"] += len(tset & fset)
+            visible["fp"] += len(fset - tset)
+            visible["fn"] += len(tset - fset)
         for t in truth:
             n_true += 1
             over = [f for f in found if f["channels"] & t["channels"]]
@@ -545,6 +553,7 @@ def score(results):
             "detected_true_findings": detected_true, "detected_physics_right": detected_right,
             "by_visibility": {"%g" % BANDS[k]: dict(v) for k, v in sorted(by_band.items())},
             "confusion_detectable": {k: dict(v) for k, v in conf_detectable.items()},
+            "detectable_runs": dict(visible),
             "confusion": {k: dict(v) for k, v in conf.items()}}
 
 
@@ -594,6 +603,11 @@ def print_matrix(s):
         lo, hi = wilson(k, n)
         print("  physics on the detectable true findings: %d/%d (%.0f %%, 95 %% CI %.0f-%.0f %%)" % (
             k, n, 100.0 * k / max(1, n), 100 * lo, 100 * hi))
+        v = Counter(s.get("detectable_runs", {}))
+        prec = v["tp"] / (v["tp"] + v["fp"]) if v["tp"] + v["fp"] else 1.0
+        rec = v["tp"] / (v["tp"] + v["fn"]) if v["tp"] + v["fn"] else 1.0
+        print("  runs whose every true finding is detectable: detect %d/%d, locate P %.2f R %.2f F1 %.2f" % (
+            v["detected"], v["runs"], prec, rec, 2 * prec * rec / (prec + rec) if prec + rec else 0.0))
     print("  physics by plant: " + ", ".join("%s %d/%d" % (k, v.get("physics_right", 0), v.get("true_findings", 0))
                                             for k, v in sorted(s.get("by_plant", {}).items())))
 
