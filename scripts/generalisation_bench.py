@@ -25,7 +25,11 @@ Every simulation also writes what the diagnosed plant file would have measured o
 (`mpm simulate --reference-out`): the run's visibility per output, sum_t (N^-1 (y - y_ref))^2 / var(a)
 with the file's noise model, is the noncentrality a test of the mismatch's known form would see. A true
 finding is detectable when the visibility of its outputs reaches DETECTABLE (20.9); the score adds
-physics and detections by visibility band and the confusion matrix of the detectable findings.
+physics and detections by visibility band and the confusion matrix of the detectable findings,
+detection and location on the runs whose every true finding is detectable, and the held-out fit
+(as ../shared/tools/score.py: some overlapping finding lowers the held-out variance). A soft
+saturation's run is simulated once more with a reference lacking the mapped channel, which gives its
+bend's visibility: what no gain change of the channel explains (bend_visibility()).
 
 Scoring, per true finding: the reported word is the true word when some
 reported finding that overlaps its channels carries it (as ../shared/tools/
@@ -405,8 +409,40 @@ def run_case_once(args, index):
                 break
             scale *= 0.7
         desc = desc + (" " + " ".join(edits[len(spec["edits"]):]) if len(edits) > len(spec["edits"]) else "")
+        bend = None
+        if "soft_saturation" in spec:  # the same run again, its reference lacking the mapped channel
+            o, i, _ = spec["soft_saturation"]
+            without = os.path.join(tmp, "reference-without.csv")
+            simulate(args.mpm, scenario, sim_plant, sim_seed, samples, extra + ed, os.path.join(tmp, "again.csv"),
+                     (without_channel(p, o, i, tmp), without))
+            bend = bend_visibility(run, ref, without, diag_plant, o)
         return diagnose(args, index, word, key, diag_plant, run, truth, desc, sim_seed, ratio,
-                        visibility(run, ref, diag_plant))
+                        visibility(run, ref, diag_plant), bend)
+
+
+def noise_model(plant):
+    """{output: (AR(1) pole, innovation variance)} of a plant file's noise section."""
+    text = open(plant).read()
+    noise = {}
+    for block in text.split("\nnoise:", 1)[1].split("  - output:")[1:]:
+        name = block.split("\n", 1)[0].strip()
+        den = [float(x) for x in block.split("den:", 1)[1].split("]")[0].strip(" [").split(",")]
+        num = block.split("num:", 1)[1].split("]")[0].strip(" [")
+        if len(den) != 2 or num.strip() != "1":
+            raise RuntimeError("visibility: %s's noise model of %s is not AR(1)" % (plant, name))
+        noise[name] = (-den[1], float(block.split("variance:", 1)[1].split("\n", 1)[0]))
+    return noise
+
+
+def output_columns(path, names):
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return {o: [float(r[o]) for r in rows] for o in names}
+
+
+def whitened(x, pole):
+    """N^-1 x for N = 1 / (1 - pole q^-1), from rest."""
+    return [x[t] - pole * (x[t - 1] if t else 0.0) for t in range(len(x))]
 
 
 def visibility(run, reference, plant):
@@ -416,28 +452,39 @@ def visibility(run, reference, plant):
     and N, var(a) are the file's noise model (AR(1) in every plant drawn here). A test that
     knew the mismatch's form and fitted its one parameter would see this noncentrality; it
     is the evidence the record holds, whatever the diagnosis does with it."""
-    _, outputs, _, _, text = parse_plant(plant)
-    noise = {}
-    for block in text.split("\nnoise:", 1)[1].split("  - output:")[1:]:
-        name = block.split("\n", 1)[0].strip()
-        den = [float(x) for x in block.split("den:", 1)[1].split("]")[0].strip(" [").split(",")]
-        num = block.split("num:", 1)[1].split("]")[0].strip(" [")
-        if len(den) != 2 or num.strip() != "1":
-            raise RuntimeError("visibility: %s's noise model of %s is not AR(1)" % (plant, name))
-        noise[name] = (-den[1], float(block.split("variance:", 1)[1].split("\n", 1)[0]))
-    with open(run) as f:
-        rows = list(csv.DictReader(f))
-    with open(reference) as f:
-        refs = list(csv.DictReader(f))
+    _, outputs, _, _, _ = parse_plant(plant)
+    noise = noise_model(plant)
+    y, y_ref = output_columns(run, outputs), output_columns(reference, outputs)
     out = {}
     for o in outputs:
         pole, var = noise[o]
-        x = [float(r[o]) - float(q[o]) for r, q in zip(rows, refs)]
-        out[o] = sum((x[t] - pole * (x[t - 1] if t else 0.0)) ** 2 for t in range(len(x))) / var
+        x = whitened([a - b for a, b in zip(y[o], y_ref[o])], pole)
+        out[o] = sum(e * e for e in x) / var
     return out
 
 
-def diagnose(args, index, word, key, plant, run, truth, desc, sim_seed, ratio, seen):
+def bend_visibility(run, reference, reference_without, plant, o):
+    """The part of a static map's visibility on output o that no gain change explains: what the
+    file leaves out (y - y_ref), less its least-squares fit by a gain change of the channel and a
+    constant, whitened as in visibility(). The channel's response to the recorded input is
+    y_ref - y_ref_without, with y_ref_without the same run's reference lacking the channel (the
+    same innovations cancel). Below DETECTABLE the map is a gain to any test of its form."""
+    pole, var = noise_model(plant)[o]
+    y, ref, without = (output_columns(f, [o])[o] for f in (run, reference, reference_without))
+    x = whitened([a - b for a, b in zip(y, ref)], pole)
+    z = whitened([a - b for a, b in zip(ref, without)], pole)
+    one = whitened([1.0] * len(x), pole)
+    # least squares of x on [z, one] by the 2x2 normal equations
+    szz, szo, soo = sum(a * a for a in z), sum(a * b for a, b in zip(z, one)), sum(b * b for b in one)
+    sxz, sxo = sum(a * b for a, b in zip(x, z)), sum(a * b for a, b in zip(x, one))
+    det = szz * soo - szo * szo
+    if det <= 0.0:
+        return sum(a * a for a in x) / var
+    cz, co = (sxz * soo - sxo * szo) / det, (sxo * szz - sxz * szo) / det
+    return sum((a - cz * b - co * c) ** 2 for a, b, c in zip(x, z, one)) / var
+
+
+def diagnose(args, index, word, key, plant, run, truth, desc, sim_seed, ratio, seen, bend=None):
     if args.keep:
         kept = os.path.join(args.keep, "run%03d" % index)
         os.makedirs(kept, exist_ok=True)
@@ -453,11 +500,16 @@ def diagnose(args, index, word, key, plant, run, truth, desc, sim_seed, ratio, s
     found = []
     for f in rep.get("findings", []):
         chans = [(c["output"], c.get("input")) for c in f["channels"]]
-        found.append({"physics": f["physics"], "channels": chans})
+        fit = f.get("fit") if isinstance(f.get("fit"), dict) else {}
+        before, after = fit.get("holdout_variance_before"), fit.get("holdout_variance_after")
+        found.append({"physics": f["physics"], "channels": chans,
+                      "fit_better": before is not None and after is not None and after < before})
     return {"index": index, "word": word, "plant": key, "desc": desc, "seed": sim_seed, "error_ratio": ratio,
             "visibility": {o: round(v, 2) for o, v in seen.items()}, "mismatch": rep.get("mismatch", False),
+            "bend_visibility": None if bend is None else round(bend, 2),
             "truth": [{"physics": t["physics"], "channels": [list(c) for c in t["channels"]]} for t in truth],
-            "found": [{"physics": f["physics"], "channels": [list(c) for c in f["channels"]]} for f in found]}
+            "found": [{"physics": f["physics"], "channels": [list(c) for c in f["channels"]],
+                       "fit_better": f["fit_better"]} for f in found]}
 
 
 # A true finding is "detectable" when its oracle noncentrality (visibility(), summed over the
@@ -489,12 +541,16 @@ def score(results):
     by_band = defaultdict(Counter)  # per visibility band (index into BANDS): true findings, detected, right
     conf_detectable = defaultdict(Counter)  # the confusion matrix of the detectable true findings
     visible = Counter()  # runs whose every true finding is detectable: runs, detected, channel tp / fp / fn
+    bends = defaultdict(Counter)  # soft saturations by their bend's visibility: reported words
+    fit_detectable = Counter()  # detectable true findings (of runs that record fits) whose fit improves
+    fit_all = Counter()  # the same over every true finding
     for r in results:
         if "error" in r:
             errors += 1
             continue
         truth = [{"physics": t["physics"], "channels": {tuple(c) for c in t["channels"]}} for t in r["truth"]]
-        found = [{"physics": f["physics"], "channels": {tuple(c) for c in f["channels"]}} for f in r["found"]]
+        found = [{"physics": f["physics"], "channels": {tuple(c) for c in f["channels"]},
+                  "fit_better": f.get("fit_better")} for f in r["found"]]
         if not truth:
             fa_n += 1
             fa += bool(r["mismatch"])
@@ -529,6 +585,12 @@ def score(results):
                 got = "missed"
             conf[t["physics"]][got] += 1
             right += got == t["physics"]
+            # as ../shared/tools/score.py: some overlapping finding lowers the held-out variance
+            fit_known = all(f["fit_better"] is not None for f in found)
+            better = any(f["fit_better"] for f in over)
+            if fit_known:
+                fit_all["true_findings"] += 1
+                fit_all["fit_better"] += better
             kind = "random" if r["plant"] == "rand" else "fixed"
             by_plant[kind]["true_findings"] += 1
             by_plant[kind]["physics_right"] += got == t["physics"]
@@ -543,6 +605,11 @@ def score(results):
                 by_band[band]["physics_right"] += got == t["physics"]
                 if seen >= DETECTABLE:
                     conf_detectable[t["physics"]][got] += 1
+                    if fit_known:
+                        fit_detectable["true_findings"] += 1
+                        fit_detectable["fit_better"] += better
+            if r.get("bend_visibility") is not None:
+                bends["bend detectable" if r["bend_visibility"] >= DETECTABLE else "bend below"][got] += 1
     prec = tp / (tp + fp) if tp + fp else 1.0
     rec = tp / (tp + fn) if tp + fn else 1.0
     f1 = 2 * prec * rec / (prec + rec) if prec + rec else 0.0
@@ -554,6 +621,8 @@ def score(results):
             "by_visibility": {"%g" % BANDS[k]: dict(v) for k, v in sorted(by_band.items())},
             "confusion_detectable": {k: dict(v) for k, v in conf_detectable.items()},
             "detectable_runs": dict(visible),
+            "soft_saturations": {k: dict(v) for k, v in bends.items()},
+            "fit_detectable": dict(fit_detectable), "fit": dict(fit_all),
             "confusion": {k: dict(v) for k, v in conf.items()}}
 
 
@@ -608,6 +677,13 @@ def print_matrix(s):
         rec = v["tp"] / (v["tp"] + v["fn"]) if v["tp"] + v["fn"] else 1.0
         print("  runs whose every true finding is detectable: detect %d/%d, locate P %.2f R %.2f F1 %.2f" % (
             v["detected"], v["runs"], prec, rec, 2 * prec * rec / (prec + rec) if prec + rec else 0.0))
+        fd, fa = s.get("fit_detectable", {}), s.get("fit", {})
+        if fd.get("true_findings"):
+            print("  held-out fit improved on %d/%d detectable true findings (%d/%d of all)" % (
+                fd["fit_better"], fd["true_findings"], fa["fit_better"], fa["true_findings"]))
+    for k, v in sorted(s.get("soft_saturations", {}).items()):
+        print("  soft saturations, %s %g: %s" % (k, DETECTABLE, ", ".join(
+            "%s %d" % (w, n) for w, n in sorted(v.items(), key=lambda x: -x[1]))))
     print("  physics by plant: " + ", ".join("%s %d/%d" % (k, v.get("physics_right", 0), v.get("true_findings", 0))
                                             for k, v in sorted(s.get("by_plant", {}).items())))
 
