@@ -143,7 +143,8 @@ std::string describe(const Context& cx, const Candidate& c, double family) {
   for (const auto& ch : c.finding.channels)
     m += p.outputs[ch.output] + "<-" + (ch.input ? p.inputs[*ch.input] : c.finding.signal.value_or("-")) + " ";
   return m + "] lr " + fmt(c.lr, 4) + " (limit " + fmt(fit_limit(cx.settings, family, c.params), 3) +
-         ", pooled with z_hold^2 " + fmt(pooled_limit(cx.settings, family, c.params), 3) + ") z_hold " +
+         ", pooled p " + fmt(pooled_evidence_p(c), 3) + " against " + fmt(pooled_level(cx.settings, family), 3) +
+         ") z_hold " +
          fmt(c.z_hold, 3) + " (expected " + fmt(c.z_expected, 3) + ")" +
          " beyond_noise " + fmt(c.lr_beyond_noise, 4) + " aic " + fmt(c.aic(), 4) + " selection " +
          fmt(selection_score(cx, c), 4) + ": " + c.finding.summary;

@@ -100,6 +100,9 @@ struct Candidate {
   double z_hold = 0.0;    // projection test on the held-out part
   double z_expected = 0.0;  // what z_hold would be on average were the correction exactly right
   double hold_gain = 0.0; // sum over outputs of ln(before / after), held-out whitened variance
+  // The held-out part's share of the samples judged (score() sets it; it
+  // weights the pooled evidence, and 0 means there is none).
+  double hold_share = 0.0;
   // The hypothesis fitted jointly with an AR(3) change of the disturbance
   // model, against that change alone: what it explains beyond a wrong N.
   double lr_beyond_noise = 0.0;
@@ -176,9 +179,9 @@ void refresh(Context& cx, std::size_t j);
 // log-likelihood gain); the fit block of its finding (and the raw one).
 double fit_level(const Settings& s, double family);
 // The fit-part limit of a candidate with `params` parameters (with the
-// held-out test), and the limit of its pooled statistic lr + z_hold^2.
+// held-out test), and the level its pooled evidence is held to.
 double fit_limit(const Settings& s, double family, int params);
-double pooled_limit(const Settings& s, double family, int params);
+double pooled_level(const Settings& s, double family);
 // The fit-part limit where the held-out part is uninformative (see passes()).
 double uninformed_limit(const Settings& s, double family, int params);
 bool passes(const Candidate& c, const Settings& s, double family);
@@ -186,6 +189,20 @@ bool passes(const Candidate& c, const Settings& s, double family);
 // their nested likelihood ratio on the fit part pooled with the held-out
 // projection z of what they change, at `level`.
 bool beyond_nested(double nested_lr, double z_hold, int df, double level);
+// The p-value of c's fit and held-out evidence pooled: the fit part's
+// sqrt(lr) and the held-out z, each weighted by the square root of its
+// share of the samples. Were the correction exactly right, sqrt(lr) would
+// be about sqrt((1 - h) n d) and z about sqrt(h n d) for an effect of d per
+// sample, so the weighted sum grows as sqrt(n d): all of the record's
+// evidence in one direction. (lr + z^2 spent a degree of freedom on z's
+// size whatever its share, and counted z < 0 as no evidence rather than as
+// evidence against.)
+double pooled_evidence_p(const Candidate& c);
+// P(sqrt(1 - h) sqrt(X) + sqrt(h) Z >= t) for X ~ chi-square(params) and Z ~
+// N(0, 1) independent, h = hold_share in (0, 1): the null tail of the pooled
+// evidence of passes(), the fit part's sqrt(lr) and the held-out z weighted
+// by their shares of the samples.
+double pooled_evidence_survival(double t, int params, double hold_share);
 double selection_score(const Context& cx, const Candidate& c);
 FitNumbers fit_numbers(const Context& cx, const Candidate& c, FitNumbers& raw);
 

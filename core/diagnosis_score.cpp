@@ -7,6 +7,8 @@
 #include <array>
 #include <cmath>
 
+#include <boost/math/quadrature/gauss_kronrod.hpp>
+
 #include "core/chi_square.hpp"
 #include "core/diagnosis_table.hpp"
 
@@ -215,6 +217,8 @@ void score(const Context& cx, Candidate& c) {
   const HoldoutProjection h = project_holdout(cx, errors);
   c.z_hold = h.z;
   c.z_expected = h.z_expected;
+  c.hold_share = static_cast<double>(cx.seg.hold_samples()) /
+                 static_cast<double>(cx.seg.hold_samples() + cx.seg.fit_samples());
 
   // Under feedback G_M u mirrors the disturbances the controller rejects, so
   // a correction built from it can take up a disturbance model that the
@@ -239,19 +243,38 @@ double fit_limit(const Settings& s, double family, int params) {
   return chi_square_quantile_upper(0.5 * fit_level(s, family), params);
 }
 
-double pooled_limit(const Settings& s, double family, int params) {
-  return chi_square_quantile_upper(0.5 * s.alpha / family, params + 1);
-}
+double pooled_level(const Settings& s, double family) { return 0.5 * s.alpha / family; }
 
 double uninformed_limit(const Settings& s, double family, int params) {
   return chi_square_quantile_upper(0.5 * s.alpha / family, params);
 }
 
+// Weights and why: diagnosis_context.hpp.
+double pooled_evidence_p(const Candidate& c) {
+  if (!(c.hold_share > 0.0 && c.hold_share < 1.0)) return 1.0;
+  const double t = std::sqrt(1.0 - c.hold_share) * std::sqrt(std::max(c.lr, 0.0)) + std::sqrt(c.hold_share) * c.z_hold;
+  return pooled_evidence_survival(t, c.params, c.hold_share);
+}
+
+double pooled_evidence_survival(double t, int params, double hold_share) {
+  if (!(hold_share > 0.0 && hold_share < 1.0) || params < 1 || !std::isfinite(t)) return std::nan("");
+  const double wf = std::sqrt(1.0 - hold_share), wh = std::sqrt(hold_share);
+  const double k = static_cast<double>(params);
+  // Over s = sqrt(X): the chi density 2 s f_k(s^2) times P(Z >= (t - wf s) / wh).
+  const auto integrand = [&](double x) {
+    const double tail = 0.5 * std::erfc((t - wf * x) / (wh * std::sqrt(2.0)));
+    return x > 0.0 ? 2.0 * x * chi_square_density(x * x, k) * tail : 0.0;
+  };
+  // The chi density is below 1e-30 beyond sqrt(k) + 12.
+  const double top = std::sqrt(k) + 12.0 + std::max(0.0, t / wf);
+  return boost::math::quadrature::gauss_kronrod<double, 31>::integrate(integrand, 0.0, top, 15, 1e-10);
+}
+
 // The evidence, at the family-wise level alpha split in halves: either the
 // fit-part test and the held-out test both pass (independent under "no
 // mismatch", so together at (fit level / 2) x (held-out level)), or the two
-// parts' evidence pooled, lr + z^2 with z > 0 (chi-square with one degree of
-// freedom more), passes at alpha / 2 over the family. The first keeps a
+// parts' evidence pooled (pooled_evidence_p()) passes at alpha / 2 over the
+// family (pooled_level()). The first keeps a
 // strong fit whose held-out part only confirms it; the second a fit just
 // under its limit whose held-out part speaks clearly (a weak channel's gain:
 // fit LR 7 against 12.6, z 4.6). Then the held-out variance must drop.
@@ -271,8 +294,7 @@ bool passes(const Candidate& c, const Settings& s, double family) {
     evidence = c.lr >= uninformed_limit(s, family, c.params);
   } else {
     const bool both = c.lr >= fit_limit(s, family, c.params) && c.z_hold >= s.holdout_z;
-    const bool pooled = beyond_nested(c.lr, c.z_hold, c.params, 0.5 * s.alpha / family);
-    evidence = (both || pooled) && c.hold_gain > 0.0;
+    evidence = (both || pooled_evidence_p(c) <= pooled_level(s, family)) && c.hold_gain > 0.0;
   }
   return evidence && (c.hypothesis->gate != Gate::beyond_noise ||
                       c.lr_beyond_noise >= chi_square_quantile_upper(s.beyond_noise_level, c.params));
