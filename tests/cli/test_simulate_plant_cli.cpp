@@ -7,10 +7,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <string>
 #include <utility>
-#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -106,21 +104,11 @@ TEST(SimulatePlantCli, EditChangesTheRunAndIsReported) {
   EXPECT_NE(bad.err.find("unknown output 'y4' (outputs: y1, y2, y3)"), std::string::npos) << bad.err;
 }
 
-// Column `name` of a CSV text, as numbers.
-std::vector<double> csv_column(const std::string& csv, const std::string& name) {
-  std::vector<double> values;
-  const std::string head = header(csv);
-  std::size_t index = 0, at = 0;
-  for (std::size_t comma; (comma = head.find(',', at)) != std::string::npos && head.substr(at, comma - at) != name;
-       at = comma + 1)
-    ++index;
-  for (std::size_t row = csv.find('\n') + 1; row < csv.size(); row = csv.find('\n', row) + 1) {
-    const char* cell = csv.c_str() + row;
-    for (std::size_t c = 0; c < index; ++c) cell = std::strchr(cell, ',') + 1;
-    values.push_back(std::strtod(cell, nullptr));
-    if (csv.find('\n', row) == std::string::npos) break;
-  }
-  return values;
+// Column `name` of a recording file, read by the project's CSV reader.
+Eigen::VectorXd csv_column(const mpm::config::Recording& rec, const std::string& name) {
+  const auto c = rec.find(name);
+  EXPECT_TRUE(c.has_value()) << name;
+  return c ? Eigen::VectorXd(rec.data.col(static_cast<Eigen::Index>(*c))) : Eigen::VectorXd();
 }
 
 // --reference-out: what the reference model would have measured on the run.
@@ -136,13 +124,13 @@ TEST(SimulatePlantCli, ReferenceOutIsWhatTheModelWouldHaveMeasured) {
                               " --out " + csv + " --reference-out " + ref);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("wrote " + ref + ": what the reference model " + plant), std::string::npos) << r.out;
-    const std::string run = read_file(csv), model = read_file(ref);
-    EXPECT_EQ(header(model), "t,y1,y2,y3");
-    EXPECT_EQ(csv_column(model, "t"), csv_column(run, "t"));
-    EXPECT_EQ(csv_column(model, "y2"), csv_column(run, "y2")) << edit;
-    EXPECT_EQ(csv_column(model, "y3"), csv_column(run, "y3")) << edit;
+    EXPECT_EQ(header(read_file(ref)), "t,y1,y2,y3");
+    const auto run = mpm::config::load_recording(csv), model = mpm::config::load_recording(ref);
+    EXPECT_TRUE(csv_column(model, "t") == csv_column(run, "t"));
+    EXPECT_TRUE(csv_column(model, "y2") == csv_column(run, "y2")) << edit;
+    EXPECT_TRUE(csv_column(model, "y3") == csv_column(run, "y3")) << edit;
     EXPECT_EQ(csv_column(model, "y1") == csv_column(run, "y1"), edit.empty()) << edit;
-    EXPECT_EQ(csv_column(model, "y1").size(), 300u);
+    EXPECT_EQ(csv_column(model, "y1").size(), 300);
   }
 }
 
