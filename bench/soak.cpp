@@ -127,7 +127,7 @@ struct MonitorProbe {
         if (index == 1) input_lags = &member;
       }
       if constexpr (std::is_same_v<T, std::vector<std::uint64_t>>) {
-        if (index == 17) output_used = &member;
+        if (index == 18) output_used = &member;
       }
       ++index;
     });

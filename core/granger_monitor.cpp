@@ -249,7 +249,7 @@ void GrangerMonitor::refresh_statistics(std::size_t j) const noexcept {
 
 void GrangerMonitor::adopt_outputs(const GrangerMonitor& part) {
   if (part.n_inputs_ != n_inputs_ || part.n_outputs_ != n_outputs_ || part.na_ != na_ || part.nb_ != nb_ ||
-      part.bank_.lags_needed() != bank_.lags_needed() || part.warmup_ != warmup_)
+      part.bank_.lags_after_gap() != bank_.lags_after_gap() || part.warmup_ != warmup_)
     throw std::invalid_argument("adopt_outputs: the monitors differ in shape or settings");
   if (part.first_output_ < first_output_ || part.end_output_ > end_output_)
     throw std::invalid_argument("adopt_outputs: the part models outputs this monitor does not");

@@ -146,6 +146,10 @@ class GrangerMonitor {
 
   // Forgets everything learnt: statistics, lags, alarms (counters are kept).
   void reset() noexcept;
+  // Setup, before the first sample: the residuals start settled (the front
+  // end skips no sample), so the first start waits only for the lags, not
+  // for the model filters' memory (RegressorBank::start_settled()).
+  void start_settled() noexcept { bank_.start_settled(); }
 
   // The outputs this monitor models (all unless constructed with a range);
   // statistics of the others stay at their initial values.

@@ -44,8 +44,10 @@ MonitorBlueprint::MonitorBlueprint(const PlantModel& plant, const MonitorSetting
       reference_(reference_variances(plant)),
       channels_(plain_lags ? std::vector<std::optional<DiscreteTf>>{} : channel_models(plant)) {}
 
-GrangerMonitor MonitorBlueprint::build(OutputRange outputs) const {
-  return GrangerMonitor(inputs_, outputs_, settings_, noise_, reference_, channels_, outputs);
+GrangerMonitor MonitorBlueprint::build(OutputRange outputs, std::size_t front_end_settle) const {
+  GrangerMonitor m(inputs_, outputs_, settings_, noise_, reference_, channels_, outputs);
+  if (front_end_settle == 0) m.start_settled();
+  return m;
 }
 
 // ---- 2. The residual front end --------------------------------------------

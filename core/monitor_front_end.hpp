@@ -60,7 +60,11 @@ class MonitorBlueprint {
  public:
   MonitorBlueprint(const PlantModel& plant, const MonitorSettings& settings, bool plain_lags = false);
   // Throws std::invalid_argument when the settings are invalid for the plant.
-  GrangerMonitor build(OutputRange outputs = {}) const;
+  // `front_end_settle`: the samples the residual front end skips at the start
+  // (settle_length()); none, and the monitor's first start waits for its lags
+  // only (GrangerMonitor::start_settled()).
+  GrangerMonitor build(OutputRange outputs = {}, std::size_t front_end_settle = kSettleUnknown) const;
+  static constexpr std::size_t kSettleUnknown = static_cast<std::size_t>(-1);
   const MonitorSettings& settings() const noexcept { return settings_; }
 
  private:

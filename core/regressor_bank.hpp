@@ -9,9 +9,11 @@
 // so the basis and the model filters start at rest there. After a start or
 // a gap the bank needs lags_needed() samples before its rows are valid: na
 // residuals, nb input samples, and the memory of the filters and of the
-// Laguerre states (zeroed at the gap) decayed to 1 %.
+// Laguerre states (zeroed at the gap) decayed to 1 %; at the first start
+// of a residual that needs no settling only the lags (start_settled()).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <optional>
 #include <vector>
@@ -33,9 +35,13 @@ class RegressorBank {
                 const std::vector<std::optional<DiscreteTf>>& channel_models, std::size_t first_output,
                 std::size_t end_output);
 
-  int lags_needed() const noexcept { return lags_needed_; }
+  // Samples before the rows are used: after a gap, the lags and then until
+  // the memory the filters lost has decayed; at the first start the same,
+  // or only the lags after start_settled().
+  int lags_needed() const noexcept { return restarted_ ? lags_needed_ : lags_first_; }
   // Enough valid consecutive samples for the rows to be valid.
-  bool filled() const noexcept { return lags_filled_ >= lags_needed_; }
+  bool filled() const noexcept { return lags_filled_ >= lags_needed(); }
+  int lags_after_gap() const noexcept { return lags_needed_; }
   // The last na residuals of output j, newest first.
   const double* residual_lags(std::size_t j) const noexcept {
     return residual_lags_.col(static_cast<Eigen::Index>(j)).data();
@@ -46,7 +52,7 @@ class RegressorBank {
   }
 
   // Real-time safe. A gap: the lags straddling it are invalid, so the bank
-  // fills again from the next sample.
+  // fills again from the next sample, and waits for its filters' memory.
   void gap() noexcept;
   // Real-time safe. Before push: at a (re)start, u becomes the input level
   // the regressors are taken about.
@@ -54,7 +60,12 @@ class RegressorBank {
   // Real-time safe. Sample k into the lags (for the row of k + 1).
   void push(const double* u, const double* residual) noexcept;
 
-  void reset() noexcept;  // everything back to rest
+  // Setup: the residual needs no settling at the first start (the front end
+  // skips no sample: every output is the controller's own prediction, or
+  // the user said so), so the rows are used once the lags are filled.
+  void start_settled() noexcept { lags_first_ = static_cast<int>(std::max(na_, nb_)); }
+
+  void reset() noexcept;  // everything back to rest: the first start again
   void reset_output(std::size_t j) noexcept;  // output j's residual lags
   // Output j's residual lags, input regressors and filters from `part`.
   void adopt_output(const RegressorBank& part, std::size_t j);
@@ -63,7 +74,7 @@ class RegressorBank {
 
   template <class V>
   void visit_state(V&& v) {
-    v(residual_lags_); v(input_lags_); v(channel_filters_); v(lags_filled_); v(input_ref_);
+    v(residual_lags_); v(input_lags_); v(channel_filters_); v(lags_filled_); v(restarted_); v(input_ref_);
   }
 
  private:
@@ -80,7 +91,20 @@ class RegressorBank {
   // u(k) yields G_ji u at k+1), or empty for plain lags.
   std::vector<std::optional<DiscreteFilter>> channel_filters_;
   int lags_filled_ = 0;            // valid consecutive samples in the lags
-  int lags_needed_ = 0;
+  int lags_needed_ = 0;            // after a gap
+  // At the first start. Where the residual starts settled, the filters
+  // begin at rest at the first input level, the level its mismatch is taken
+  // about, so G (u - u_ref) from rest is the mismatch's own regressor and a
+  // wait for a memory that was never lost would only discard samples (the
+  // first 985 of a real TCLab record with its controller's prediction, all
+  // of one of 250). Where the
+  // front end skips a start-up transient of the nominal model, the wait
+  // stays: it is capped at a tenth of the record offline, and the rest of
+  // that transient would reach the regressions (the paper's 4x4 tank).
+  // After a gap the filters restart at rest while the plant still answers
+  // the inputs before it.
+  int lags_first_ = 0;
+  bool restarted_ = false;         // a gap since the last reset
   Eigen::VectorXd input_ref_;      // input level at (re)start
 };
 

@@ -19,7 +19,7 @@ NullRun null_alarm_run(const PlantModel& plant, const MonitorSettings& settings,
   const config::Recording rec = sim::simulate(loop, samples, "null");
   const config::BoundRecording bound = config::bind(plant, rec);
   const ResidualSeries series = compute_residuals(plant, rec, bound);
-  GrangerMonitor monitor = MonitorBlueprint(plant, settings).build();
+  GrangerMonitor monitor = MonitorBlueprint(plant, settings).build({}, series.transient);
   const SequentialDetector& det = monitor.detector();
   const std::size_t p = plant.n_outputs(), kw = det.windows();
   const double d = static_cast<double>(det.dof());

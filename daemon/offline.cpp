@@ -36,9 +36,10 @@ ResidualSeries compute_residuals(const PlantModel& plant, const config::Recordin
   return s;
 }
 
-MonitorPartFactory monitor_factory(const PlantModel& plant, const MonitorSettings& settings, bool plain_lags) {
-  return [blueprint = MonitorBlueprint(plant, settings, plain_lags)](OutputRange outputs) {
-    return blueprint.build(outputs);
+MonitorPartFactory monitor_factory(const PlantModel& plant, const MonitorSettings& settings, bool plain_lags,
+                                   std::size_t front_end_settle) {
+  return [blueprint = MonitorBlueprint(plant, settings, plain_lags), front_end_settle](OutputRange outputs) {
+    return blueprint.build(outputs, front_end_settle);
   };
 }
 
@@ -91,7 +92,7 @@ void run_monitor_parallel(GrangerMonitor& monitor, const ResidualSeries& s, std:
 
 GrangerMonitor monitor_record(const PlantModel& plant, const ResidualSeries& s, const MonitorSettings& settings,
                               std::size_t threads, bool plain_lags, const PartSampleCallback& on_sample) {
-  const MonitorPartFactory make = monitor_factory(plant, settings, plain_lags);
+  const MonitorPartFactory make = monitor_factory(plant, settings, plain_lags, s.transient);
   GrangerMonitor monitor = make(OutputRange{});
   run_monitor_parallel(monitor, s, threads, make, on_sample);
   return monitor;

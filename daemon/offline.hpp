@@ -68,7 +68,8 @@ using MonitorPartFactory = std::function<GrangerMonitor(OutputRange)>;
 using PartSampleCallback = std::function<void(std::size_t, const GrangerMonitor&)>;
 
 // Parts of the monitor the blueprint builds (core/monitor_front_end.hpp).
-MonitorPartFactory monitor_factory(const PlantModel& plant, const MonitorSettings& settings, bool plain_lags = false);
+MonitorPartFactory monitor_factory(const PlantModel& plant, const MonitorSettings& settings, bool plain_lags = false,
+                                   std::size_t front_end_settle = MonitorBlueprint::kSettleUnknown);
 
 // Threads worth using for a monitor of `outputs` outputs on this machine:
 // one per core, at most one per output, at least one.

@@ -48,7 +48,7 @@ PaperCaseResult run_paper_case(const std::string& scenario, std::uint64_t seed, 
 
   const config::BoundRecording bound = config::bind(plant, rec);
   const ResidualSeries series = compute_residuals(plant, rec, bound);
-  PaperCaseResult out{plant, MonitorBlueprint(plant, settings).build(), {}, {}, {}, false, rec.samples()};
+  PaperCaseResult out{plant, MonitorBlueprint(plant, settings).build({}, series.transient), {}, {}, {}, false, rec.samples()};
   run_monitor(out.monitor, series, [](std::size_t, const GrangerMonitor&) {});
   const RecordVerdict verdict = record_verdict(out.monitor);
   out.located = verdict.located;

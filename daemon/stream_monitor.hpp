@@ -92,7 +92,7 @@ inline StreamedRecord monitor_csv_stream(const PlantModel& plant, const RowSourc
     all_sim = all_sim && use_sim[j];
   }
   const std::size_t settle = settle_length(plant, settle_samples, record_settle_cap(n), all_sim);
-  StreamedRecord out{MonitorBlueprint(plant, settings, plain_lags).build(), n, settle, {}};
+  StreamedRecord out{MonitorBlueprint(plant, settings, plain_lags).build({}, settle), n, settle, {}};
   ResidualFrontEnd front(plant, origin.u0(), settle, std::move(use_sim));
   const auto reader = open();
   for (std::size_t k = 0; reader->next(row); ++k) {

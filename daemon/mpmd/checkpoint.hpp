@@ -33,7 +33,8 @@
 
 namespace mpm::checkpoint {
 
-constexpr std::uint32_t kVersion = 1;
+// 2: the regressor bank says whether it restarted after a gap (its fill rule).
+constexpr std::uint32_t kVersion = 2;
 constexpr std::size_t kHeaderSize = 40;
 // Larger files are refused before they are read (a 50 x 50 plant's state
 // with the default orders is about 200 MB).

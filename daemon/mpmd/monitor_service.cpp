@@ -64,6 +64,12 @@ MonitorSettings sequential_share(const PlantModel& plant, const ServiceSettings&
   return m;
 }
 
+// The samples the live front end skips at the start (the monitor's first
+// start follows it: MonitorBlueprint::build).
+std::size_t live_settle(const PlantModel& plant, const ServiceSettings& s) {
+  return settle_length(plant, s.settle_samples, kLiveSettleCap);
+}
+
 }  // namespace
 
 MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& settings, AlarmSink on_alarm)
@@ -71,8 +77,9 @@ MonitorService::MonitorService(const PlantModel& plant, const ServiceSettings& s
       settings_(settings),
       on_alarm_(std::move(on_alarm)),
       // The same monitor and front end as `mpm monitor` builds offline.
-      monitor_(MonitorBlueprint(plant, sequential_share(plant, settings), settings.plain_lags).build()),
-      front_(plant, settle_length(plant, settings.settle_samples, kLiveSettleCap)),
+      monitor_(MonitorBlueprint(plant, sequential_share(plant, settings), settings.plain_lags)
+                   .build({}, live_settle(plant, settings))),
+      front_(plant, live_settle(plant, settings)),
       tracker_(settings.max_sequence_jump),
       residual_(plant.n_outputs(), 0.0),
       nan_u_(plant.n_inputs(), kNaN),

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <random>
 #include <set>
 #include <string>
 #include <tuple>
@@ -278,6 +279,40 @@ class DiagnoseOutput : public ::testing::Test {
   }
   std::string csv_;
 };
+
+// A record of 300 samples of a slow plant (pole 0.995: its model filters
+// take 919 samples to forget a restart) whose every output carries the
+// controller's prediction: the residual needs no settling, so the monitor
+// uses it from the first lags on and the record is decided (it used to wait
+// out the filters' memory and say "cannot decide", as on the first 250
+// samples of a real TCLab run).
+TEST(DiagnoseCli, AShortRecordWithTheControllersPredictionIsDecided) {
+  const std::string plant = tmp_path("slow.yaml"), csv = tmp_path("slow_short.csv");
+  std::ofstream(plant) << "plant: slow\nsample_time: 1\ninputs: [u1, u2]\noutputs: [y1, y2]\nmodel:\n"
+                          "  - {output: y1, input: u1, num: [0.005], den: [1, -0.995], delay: 1}\n"
+                          "  - {output: y1, input: u2, num: [0.002], den: [1, -0.995], delay: 1}\n"
+                          "  - {output: y2, input: u1, num: [0.001], den: [1, -0.995], delay: 1}\n"
+                          "  - {output: y2, input: u2, num: [0.004], den: [1, -0.995], delay: 1}\n";
+  {
+    std::ofstream f(csv);
+    f << "t,u1,u2,y1,y2,sim_y1,sim_y2\n";
+    std::mt19937 rng(7);
+    std::normal_distribution<double> noise(0.0, 0.1);
+    double u1 = 0.0, u2 = 0.0, s1 = 0.0, s2 = 0.0;  // the model's prediction, from rest
+    for (int k = 0; k < 300; ++k) {
+      if (k % 25 == 0) u1 = noise(rng) * 10.0;
+      if (k % 40 == 0) u2 = noise(rng) * 10.0;
+      f << k << ',' << u1 << ',' << u2 << ',' << s1 + noise(rng) << ',' << s2 + noise(rng) << ',' << s1 << ',' << s2
+        << "\n";
+      s1 = 0.995 * s1 + 0.005 * u1 + 0.002 * u2;
+      s2 = 0.995 * s2 + 0.001 * u1 + 0.004 * u2;
+    }
+  }
+  const auto r = mpm::test::run_captured(kMpm + " diagnose --quiet --plant " + plant + " --data " + csv, "mpm_diag_");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"loops\": ["), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"mismatch\": false"), std::string::npos) << r.out;
+}
 
 TEST_F(DiagnoseOutput, JsonEqualToDataIsRefusedAndTheRecordingKept) {
   const std::string before = read_file(csv_);

@@ -116,6 +116,34 @@ TEST(GrangerMonitor, ConditionalTestIsCalibratedUnderNoCausality) {
   EXPECT_LT(rate, 0.11);
 }
 
+// Model-filtered regressors of a slow channel (pole 0.995: 1 % after 919
+// samples). At the first start the monitor waits for the filters' memory
+// unless told the residual starts settled; after a gap it waits either way,
+// and reset() makes the next sample a first start again.
+TEST(GrangerMonitor, ASettledStartUsesRowsOnceTheLagsAreFilled) {
+  const DiscreteTf slow{{0.005}, {1, -0.995}, 1};
+  const std::vector<std::optional<DiscreteTf>> channels(4, slow);
+  const MonitorSettings s = test_settings();
+  const int lags = std::max(s.ar_order, s.input_order);
+  const auto used_after = [&](GrangerMonitor& m, PlantedRun& run, int n) {
+    const std::uint64_t before = m.counters().used;
+    run.feed(m, n);
+    return m.counters().used - before;
+  };
+  PlantedRun run(5);
+  GrangerMonitor waiting(2, 2, s, wood_berry_noise(5), {}, channels);
+  EXPECT_EQ(used_after(waiting, run, 600), 0u) << "the wait for the filters' memory at the first start";
+  GrangerMonitor settled(2, 2, s, wood_berry_noise(5), {}, channels);
+  settled.start_settled();
+  EXPECT_EQ(used_after(settled, run, 600), static_cast<std::uint64_t>(600 - lags));
+  // A gap: the filters restart at rest while the plant goes on answering.
+  const double gap_u[2] = {NAN, NAN}, gap_d[2] = {NAN, NAN};
+  settled.update(gap_u, gap_d);
+  EXPECT_EQ(used_after(settled, run, 600), 0u);
+  settled.reset();
+  EXPECT_EQ(used_after(settled, run, 100), static_cast<std::uint64_t>(100 - lags));
+}
+
 TEST(GrangerMonitor, GapsAreSkippedCountedAndRecovered) {
   PlantedRun run(3);
   run.dg[1][0] = DiscreteFilter(DiscreteTf{{0.3}, {1, -0.8}, 2});
