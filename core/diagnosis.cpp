@@ -335,11 +335,16 @@ std::set<std::string> established_signals(const Problem& p,
 Result diagnose(const Problem& problem, const Settings& settings, Progress progress) {
   Result r;
   Context cx = prepare(problem, settings);
-  if (cx.seg.fit_samples() < 200 || cx.seg.hold_samples() < 100) {
+  if (cx.seg.fit_samples() < settings.min_fit_samples || cx.seg.hold_samples() < settings.min_hold_samples) {
     r.notes.push_back("too few usable samples to fit hypotheses");
     for (bool f : problem.monitor_flag) r.mismatch = r.mismatch || f;
     return r;
   }
+  if (cx.seg.fit_samples() < settings.level_held_fit_samples)
+    r.notes.push_back("a short record: " + std::to_string(cx.seg.fit_samples()) +
+                      " fit samples, the false-alarm bound was measured to hold from " +
+                      std::to_string(settings.level_held_fit_samples) +
+                      "; healthy records this short get a finding about three times as often");
   for (std::size_t i = 0; i < cx.n_in(); ++i)
     if (!cx.excited[i]) r.notes.push_back("input " + problem.inputs[i] + " does not move: its channels are not analysed");
 

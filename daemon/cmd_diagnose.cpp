@@ -15,6 +15,7 @@
 #include "config/plant_loader.hpp"
 #include "core/diagnosis.hpp"
 #include "core/granger_monitor.hpp"
+#include "core/mimo_model.hpp"
 #include "daemon/args.hpp"
 #include "daemon/command.hpp"
 #include "daemon/data_input.hpp"
@@ -188,6 +189,17 @@ int run(int argc, char** argv) {
                    "least %llu\n",
                    static_cast<unsigned long long>(d.monitor.counters().used), d.samples,
                    static_cast<unsigned long long>(d.needed));
+      // A record shorter than the nominal model takes to settle, whose
+      // residual the tool computes from rest: what would decide it.
+      // (Integrating channels never settle: the cap, and no hint.)
+      constexpr std::size_t kNeverSettles = 10'000'000;
+      if (const std::size_t settling = settling_samples(plant, 0.01, kNeverSettles);
+          settling < kNeverSettles && d.samples < 2 * settling)
+        std::fprintf(stderr,
+                     "mpm diagnose: the model takes %zu samples to settle from rest; a record this short "
+                     "is decided from its first samples when it carries the controller's prediction of "
+                     "every output (sim_<output> columns, docs/formats.md section 2)\n",
+                     settling);
       return kExitUndecided;
     }
 

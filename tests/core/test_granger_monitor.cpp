@@ -121,8 +121,8 @@ TEST(GrangerMonitor, ConditionalTestIsCalibratedUnderNoCausality) {
 // unless told the residual starts settled; after a gap it waits either way,
 // and reset() makes the next sample a first start again.
 TEST(GrangerMonitor, ASettledStartUsesRowsOnceTheLagsAreFilled) {
-  const DiscreteTf slow{{0.005}, {1, -0.995}, 1};
-  const std::vector<std::optional<DiscreteTf>> channels(4, slow);
+  std::vector<std::optional<DiscreteTf>> channels;
+  for (int c = 0; c < 4; ++c) channels.emplace_back(DiscreteTf{{0.005}, {1, -0.995}, 1});
   const MonitorSettings s = test_settings();
   const int lags = std::max(s.ar_order, s.input_order);
   const auto used_after = [&](GrangerMonitor& m, PlantedRun& run, int n) {
