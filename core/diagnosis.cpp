@@ -142,7 +142,7 @@ std::string describe(const Context& cx, const Candidate& c, double family) {
   std::string m = "  candidate " + c.finding.physics + " [";
   for (const auto& ch : c.finding.channels)
     m += p.outputs[ch.output] + "<-" + (ch.input ? p.inputs[*ch.input] : c.finding.signal.value_or("-")) + " ";
-  return m + "] lr " + fmt(c.lr, 4) + " (limit " + fmt(fit_limit(cx.settings, family, c.params), 3) +
+  return m + "] lr " + fmt(c.lr, 4) + " (limit " + fmt(fit_limit(cx.settings, family, c.test_params()), 3) +
          ", pooled p " + fmt(pooled_evidence_p(c), 3) + " against " + fmt(pooled_level(cx.settings, family), 3) +
          ") z_hold " +
          fmt(c.z_hold, 3) + " (expected " + fmt(c.z_expected, 3) + ")" +
@@ -344,7 +344,7 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
     r.notes.push_back("a short record: " + std::to_string(cx.seg.fit_samples()) +
                       " fit samples, the false-alarm bound was measured to hold from " +
                       std::to_string(settings.level_held_fit_samples) +
-                      "; healthy records this short get a finding about three times as often");
+                      "; healthy records this short get a finding about 2.5 times as often");
   for (std::size_t i = 0; i < cx.n_in(); ++i)
     if (!cx.excited[i]) r.notes.push_back("input " + problem.inputs[i] + " does not move: its channels are not analysed");
 

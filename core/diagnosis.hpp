@@ -96,8 +96,8 @@ struct Settings {
   long min_hold_samples = 100;
   // Below this many fit samples (records of about 1000 samples) the report
   // notes that its false-alarm bound was not seen to hold: healthy records
-  // of 500-800 samples got a finding about three times as often as the
-  // bound (docs/method.md, "Short records").
+  // of 500-800 samples got a finding about 2.5 times as often as the bound
+  // (docs/method.md, "Short records").
   long level_held_fit_samples = 600;
   int max_extra_delay = 15;     // dead-time search range (samples)
   bool verbose = false;         // report every candidate through the progress callback

@@ -96,6 +96,11 @@ struct Candidate {
   Facts facts;  // for the finding's sentence
   std::vector<OutputFit> fits;
   int params = 0;
+  // Parameters searched on a grid that the record cannot identify without a
+  // change (the ARMA(1,1) noise form's pole, which cancels its zero): the
+  // evidence tests count them (test_params()), the selection score does not.
+  int unidentified = 0;
+  int test_params() const { return params + unidentified; }
   double lr = 0.0;        // sum over outputs of n_fit ln(before / after), whitened
   double z_hold = 0.0;    // projection test on the held-out part
   double z_expected = 0.0;  // what z_hold would be on average were the correction exactly right

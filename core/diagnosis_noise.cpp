@@ -54,6 +54,8 @@ void fit_disturbance_model(const Context& cx, const Hypothesis& h, const Site& s
     std::vector<OutputFit> fits;
     fits.push_back(std::move(of));
     Candidate c = make_candidate(cx, h, {{j, std::nullopt}}, std::move(fits), params);
+    // The ARMA(1,1) pole is searched; without a change it cancels the zero.
+    c.unidentified = correction.den.size() > 1 ? 1 : 0;
     if (!passes(c, cx.settings, forms_family)) continue;
     if (!best || c.bic(std::log(static_cast<double>(n_fit))) > best->bic(std::log(static_cast<double>(n_fit)))) {
       best = std::move(c);

@@ -253,7 +253,7 @@ double uninformed_limit(const Settings& s, double family, int params) {
 double pooled_evidence_p(const Candidate& c) {
   if (!(c.hold_share > 0.0 && c.hold_share < 1.0)) return 1.0;
   const double t = std::sqrt(1.0 - c.hold_share) * std::sqrt(std::max(c.lr, 0.0)) + std::sqrt(c.hold_share) * c.z_hold;
-  return pooled_evidence_survival(t, c.params, c.hold_share);
+  return pooled_evidence_survival(t, c.test_params(), c.hold_share);
 }
 
 double pooled_evidence_survival(double t, int params, double hold_share) {
@@ -291,9 +291,9 @@ double pooled_evidence_survival(double t, int params, double hold_share) {
 bool passes(const Candidate& c, const Settings& s, double family) {
   bool evidence = false;
   if (c.z_expected < s.holdout_informative_z) {
-    evidence = c.lr >= uninformed_limit(s, family, c.params);
+    evidence = c.lr >= uninformed_limit(s, family, c.test_params());
   } else {
-    const bool both = c.lr >= fit_limit(s, family, c.params) && c.z_hold >= s.holdout_z;
+    const bool both = c.lr >= fit_limit(s, family, c.test_params()) && c.z_hold >= s.holdout_z;
     evidence = (both || pooled_evidence_p(c) <= pooled_level(s, family)) && c.hold_gain > 0.0;
   }
   return evidence && (c.hypothesis->gate != Gate::beyond_noise ||
