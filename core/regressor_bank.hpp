@@ -97,12 +97,11 @@ class RegressorBank {
   // about, so G (u - u_ref) from rest is the mismatch's own regressor and a
   // wait for a memory that was never lost would only discard samples (the
   // first 985 of a real TCLab record with its controller's prediction, all
-  // of one of 250). Where the
-  // front end skips a start-up transient of the nominal model, the wait
-  // stays: it is capped at a tenth of the record offline, and the rest of
-  // that transient would reach the regressions (the paper's 4x4 tank).
-  // After a gap the filters restart at rest while the plant still answers
-  // the inputs before it.
+  // of one of 250). Where the front end skips a start-up transient of the
+  // nominal model, the wait stays: that skip is capped at a tenth of the
+  // record offline, and the rest of the transient would reach the
+  // regressions (the paper's 4x4 tank). After a gap the filters restart at
+  // rest while the plant still answers the inputs before it.
   int lags_first_ = 0;
   bool restarted_ = false;         // a gap since the last reset
   Eigen::VectorXd input_ref_;      // input level at (re)start
