@@ -45,14 +45,14 @@ RegressorBank::RegressorBank(std::size_t n_inputs, std::size_t n_outputs, std::s
   lags_needed_ = static_cast<int>(std::max(na_, nb_)) + filter_settle;
   if (input_pole > 0.0)
     lags_needed_ = std::max(lags_needed_, static_cast<int>(nb_) + static_cast<int>(std::ceil(std::log(0.01) / std::log(input_pole))));
-  lags_first_ = lags_needed_;
+  lags_first_ = lags_wait_ = lags_needed_;
   residual_lags_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(na_), static_cast<Eigen::Index>(n_outputs));
   input_ref_ = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n_inputs));
 }
 
 void RegressorBank::gap() noexcept {
   lags_filled_ = 0;
-  restarted_ = true;
+  lags_wait_ = lags_needed_;
   input_lags_.setZero();
   for (auto& f : channel_filters_)
     if (f) f->reset(0.0);
@@ -102,7 +102,7 @@ void RegressorBank::reset() noexcept {
   for (auto& f : channel_filters_)
     if (f) f->reset(0.0);
   lags_filled_ = 0;
-  restarted_ = false;
+  lags_wait_ = lags_first_;
 }
 
 void RegressorBank::reset_output(std::size_t j) noexcept { residual_lags_.col(static_cast<Eigen::Index>(j)).setZero(); }
@@ -118,7 +118,7 @@ void RegressorBank::adopt_output(const RegressorBank& part, std::size_t j) {
 
 void RegressorBank::adopt_shared(const RegressorBank& part) {
   lags_filled_ = part.lags_filled_;
-  restarted_ = part.restarted_;
+  lags_wait_ = part.lags_wait_;
   input_ref_ = part.input_ref_;
 }
 

@@ -38,9 +38,9 @@ class RegressorBank {
   // Samples before the rows are used: after a gap, the lags and then until
   // the memory the filters lost has decayed; at the first start the same,
   // or only the lags after start_settled().
-  int lags_needed() const noexcept { return restarted_ ? lags_needed_ : lags_first_; }
+  int lags_needed() const noexcept { return lags_wait_; }
   // Enough valid consecutive samples for the rows to be valid.
-  bool filled() const noexcept { return lags_filled_ >= lags_needed(); }
+  bool filled() const noexcept { return lags_filled_ >= lags_wait_; }
   int lags_after_gap() const noexcept { return lags_needed_; }
   // The last na residuals of output j, newest first.
   const double* residual_lags(std::size_t j) const noexcept {
@@ -63,7 +63,10 @@ class RegressorBank {
   // Setup: the residual needs no settling at the first start (the front end
   // skips no sample: every output is the controller's own prediction, or
   // the user said so), so the rows are used once the lags are filled.
-  void start_settled() noexcept { lags_first_ = static_cast<int>(std::max(na_, nb_)); }
+  void start_settled() noexcept {
+    lags_first_ = static_cast<int>(std::max(na_, nb_));
+    if (lags_filled_ == 0) lags_wait_ = lags_first_;
+  }
 
   void reset() noexcept;  // everything back to rest: the first start again
   void reset_output(std::size_t j) noexcept;  // output j's residual lags
@@ -74,7 +77,7 @@ class RegressorBank {
 
   template <class V>
   void visit_state(V&& v) {
-    v(residual_lags_); v(input_lags_); v(channel_filters_); v(lags_filled_); v(restarted_); v(input_ref_);
+    v(residual_lags_); v(input_lags_); v(channel_filters_); v(lags_filled_); v(lags_wait_); v(input_ref_);
   }
 
  private:
@@ -103,7 +106,7 @@ class RegressorBank {
   // regressions (the paper's 4x4 tank). After a gap the filters restart at
   // rest while the plant still answers the inputs before it.
   int lags_first_ = 0;
-  bool restarted_ = false;         // a gap since the last reset
+  int lags_wait_ = 0;              // now: lags_first_ until a gap, then lags_needed_
   Eigen::VectorXd input_ref_;      // input level at (re)start
 };
 

@@ -33,7 +33,7 @@
 
 namespace mpm::checkpoint {
 
-// 2: the regressor bank says whether it restarted after a gap (its fill rule).
+// 2: the regressor bank's current fill wait (after a gap, or at the first start).
 constexpr std::uint32_t kVersion = 2;
 constexpr std::size_t kHeaderSize = 40;
 // Larger files are refused before they are read (a 50 x 50 plant's state
