@@ -14,6 +14,8 @@ packages=(
   libjchart2d-java xvfb xdotool imagemagick
   # the HTML report inlines dygraphs; its test renders it in headless Chromium
   libjs-dygraphs chromium python3 python3-jsonschema
+  # outside the suite: scripts/generalisation_bench.py and ../shared/tools/score.py
+  python3-numpy python3-yaml
 )
 missing=()
 for p in "${packages[@]}"; do
