@@ -29,6 +29,8 @@ const std::vector<FieldRow<Settings>>& Settings::fields() {
   static const std::vector<FieldRow<Settings>> rows = {
       {"alpha", [](Settings& s) { return &s.alpha; }, {.min = 0.0, .max = 0.5, .min_open = true, .max_open = true},
        "false-alarm level of each look: the process hypotheses, a changed disturbance model"},
+      {"holdout_phase", [](Settings& s) { return &s.holdout_phase; }, {.min = 0, .max = 2, .whole = true},
+       "which third of the ten interleaved blocks is held out (2: the 3rd, 6th and 9th tenths)"},
   };
   return rows;
 }

@@ -99,12 +99,19 @@ struct Settings {
   // of 500-800 samples got a finding about 2.5 times as often as the bound
   // (docs/method.md, "Short records").
   long level_held_fit_samples = 600;
+  // Which third of the ten interleaved blocks is held out: 2 (the third,
+  // sixth and ninth tenths of the record, where every method choice was
+  // judged), 0 or 1 (the blocks moved by one or two). Another phase is the
+  // same method on another split: how much a result moves with it is the
+  // split's luck (docs/method.md, "Diagnosis: which physics").
+  int holdout_phase = 2;
   int max_extra_delay = 15;     // dead-time search range (samples)
   bool verbose = false;         // report every candidate through the progress callback
   std::size_t threads = 1;      // hypothesis generators run on this many threads (same result for any)
 
-  // The settings an engineer sets (`mpm diagnose --alpha`); the others are
-  // the method's.
+  // The settings an engineer sets (`mpm diagnose --alpha`, and
+  // `--holdout-phase` to see whether a finding stands on another split); the
+  // others are the method's.
   static const std::vector<FieldRow<Settings>>& fields();
 };
 

@@ -124,13 +124,13 @@ Context prepare(const Problem& p, const Settings& s) {
   }
   if (first < 0) first = n;
   cx.seg.begin = first;
-  // Ten blocks; every third one (30 %) held out.
+  // Ten blocks; every third one (30 %) held out, from Settings::holdout_phase on.
   cx.seg.fit.assign(static_cast<std::size_t>(n), 0);
   cx.seg.hold.assign(static_cast<std::size_t>(n), 0);
   const Index block = std::max<Index>(1, (n - first) / 10);
   for (Index k = first; k < n; ++k) {
     if (!cx.valid[static_cast<std::size_t>(k)]) continue;
-    const bool held = std::min<Index>(9, (k - first) / block) % 3 == 2;
+    const bool held = std::min<Index>(9, (k - first) / block) % 3 == s.holdout_phase;
     (held ? cx.seg.hold : cx.seg.fit)[static_cast<std::size_t>(k)] = 1;
     ++(held ? cx.seg.hold_n : cx.seg.fit_n);
   }

@@ -98,10 +98,10 @@ std::string finding_json(const PlantModel& plant, const diagnosis::Finding& f) {
 }
 
 std::string report_json(const PlantModel& plant, std::size_t samples, const GrangerMonitor& m,
-                        const RecordVerdict& verdict, const diagnosis::Result& r, double alpha) {
+                        const RecordVerdict& verdict, const diagnosis::Result& r, const diagnosis::Settings& settings) {
   std::ostringstream o;
-  o << "{\n  \"schema\": \"mpm.diagnosis/1\",\n  \"samples\": " << samples << ",\n  \"alpha\": " << number(alpha)
-    << ",\n  \"mismatch\": " << (r.mismatch ? "true" : "false") << ",\n  \"loops\": [\n";
+  o << "{\n  \"schema\": \"mpm.diagnosis/1\",\n  \"samples\": " << samples << ",\n  \"alpha\": "
+    << number(settings.alpha) << ",\n  \"holdout_phase\": " << settings.holdout_phase << ",\n  \"mismatch\": " << (r.mismatch ? "true" : "false") << ",\n  \"loops\": [\n";
   for (std::size_t j = 0; j < plant.n_outputs(); ++j) {
     bool loop_mismatch = verdict.loop_mismatch[j];
     for (const auto& f : r.findings)
@@ -178,7 +178,7 @@ int run(int argc, char** argv) {
         {.verbose = args.flag("verbose"),
          .progress = g_quiet ? nullptr : &progress,
          .on_sample = args.get("html") ? trace.callback() : PartSampleCallback{},
-         .alpha = settings.alpha});
+         .settings = settings});
     // A header-only or all-NaN record leaves every statistic at its prior
     // (F = 0, p = 1): that is no evidence of a match, so say so instead of
     // printing "mismatch": false.
@@ -203,7 +203,7 @@ int run(int argc, char** argv) {
       return kExitUndecided;
     }
 
-    const std::string json = report_json(plant, d.samples, d.monitor, d.verdict, d.result, settings.alpha);
+    const std::string json = report_json(plant, d.samples, d.monitor, d.verdict, d.result, settings);
     if (const auto out = args.get("json"))
       config::write_output_file(*out, json);
     else

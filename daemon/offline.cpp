@@ -139,7 +139,7 @@ RecordDiagnosis diagnose_record(const PlantModel& plant, config::Recording&& rec
   if (options.progress) options.progress("residuals computed; running the Granger monitor over the record");
   MonitorSettings settings;
   settings.forgetting = kRecordForgetting;
-  settings.false_alarm = options.alpha;
+  settings.false_alarm = options.settings.alpha;
   RecordDiagnosis r{.samples = rec.samples(),
                     .monitor = monitor_record(plant, series, settings, replay_threads(plant.n_outputs()), false,
                                               options.on_sample)};
@@ -161,9 +161,8 @@ RecordDiagnosis diagnose_record(const PlantModel& plant, config::Recording&& rec
   // residual series it was built from are not held while they run.
   rec.data.resize(0, 0);
   series = ResidualSeries{};
-  diagnosis::Settings dsettings;
+  diagnosis::Settings dsettings = options.settings;
   dsettings.verbose = options.verbose;
-  dsettings.alpha = options.alpha;
   dsettings.threads = replay_threads(std::thread::hardware_concurrency());
   r.result = diagnosis::diagnose(r.problem, dsettings, options.progress);
   if (r.verdict.diverging) r.result.notes.push_back("the monitor finds a diverging loop: its statistics are not trusted");

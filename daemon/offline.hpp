@@ -102,9 +102,11 @@ struct RecordDiagnosisOptions {
   bool verbose = false;                      // every hypothesis' statistics to `progress`
   diagnosis::Progress progress = nullptr;    // progress lines (may be empty)
   PartSampleCallback on_sample;              // the monitor after each sample (the HTML report's trace)
-  // The diagnosis' false-alarm level per look (diagnosis::Settings::alpha),
-  // and the monitor's record verdict at kUnexplainedShare of it.
-  double alpha = diagnosis::Settings{}.alpha;
+  // The diagnosis' settings as the engineer set them (the rows of
+  // diagnosis::Settings::fields(); verbose and threads are this pipeline's).
+  // Its alpha is the false-alarm level per look, and the monitor's record
+  // verdict is made at kUnexplainedShare of it.
+  diagnosis::Settings settings;
 };
 
 // The share of the false-alarm level that `mpm diagnose` gives the

@@ -5,6 +5,7 @@ seeds, scored as a confusion matrix by word.
 
 usage: scripts/generalisation_bench.py [--mpm build/daemon/mpm] [--runs 200] [--jobs 1] [--seed 1] [--random-fraction 0.5]
                                        [--out bench.json] [--words gain,deadband] [--keep DIR] [--alpha A]
+                                       [--holdout-phase P]
 
 Each run draws a plant (Wood-Berry, the 3x3, the nonlinear quadruple tank, or
 a random stable plant: 2-4 inputs and outputs, first- and second-order
@@ -493,6 +494,8 @@ def diagnose(args, index, word, key, plant, run, truth, desc, sim_seed, ratio, s
         shutil.copy(run, os.path.join(kept, "run.csv"))
     out = run + ".json"
     level = [] if args.alpha is None else ["--alpha", repr(args.alpha)]
+    if args.holdout_phase is not None:
+        level += ["--holdout-phase", str(args.holdout_phase)]
     r = subprocess.run([args.mpm, "diagnose", "--quiet", "--plant", plant, "--data", run, "--json", out] + level,
                        capture_output=True, text=True)
     if r.returncode != 0:
@@ -705,6 +708,8 @@ def main():
     ap.add_argument("--verbose", action="store_true", help="one line per run")
     ap.add_argument("--alpha", type=float, default=None,
                     help="mpm diagnose --alpha: its false-alarm level per look (default: mpm's own)")
+    ap.add_argument("--holdout-phase", type=int, choices=(0, 1, 2), default=None,
+                    help="mpm diagnose --holdout-phase: which third of the blocks is held out (default: mpm's own)")
     ap.add_argument("--keep", default="", help="copy each run's plant file and recording to KEEP/runNNN/ (to rerun one)")
     args = ap.parse_args()
     args.words = [w for w in args.words.split(",") if w]
@@ -728,7 +733,8 @@ def main():
         with open(args.out, "w") as f:
             json.dump({"args": {"runs": args.runs, "seed": args.seed, "words": args.words,
                                 "none_fraction": args.none_fraction,
-                                "random_fraction": args.random_fraction, "alpha": args.alpha}, "score": s, "runs": results}, f, indent=1)
+                                "random_fraction": args.random_fraction, "alpha": args.alpha,
+                                "holdout_phase": args.holdout_phase}, "score": s, "runs": results}, f, indent=1)
     return 0
 
 

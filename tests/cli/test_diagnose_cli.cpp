@@ -366,6 +366,33 @@ TEST_F(DiagnoseOutput, AlphaIsTheReportsLevelAndOutOfRangeIsAUsageError) {
   }
 }
 
+// The held-out phase is a flag from the settings' table: another split of
+// the same record, whose held-out blocks (and so the finding's held-out
+// variance) differ.
+TEST_F(DiagnoseOutput, HoldoutPhaseIsAFlagAndOutOfRangeIsAUsageError) {
+  const std::string mismatched = mpm::test::per_test_tmp_path("mpm_diag_out_", "dead_time.csv");
+  ASSERT_EQ(run_quietly(kMpm + " simulate --scenario wood-berry-g12-dead-time --samples 3000 --seed 3 --out " +
+                        mismatched),
+            0);
+  const auto usual = diagnose(mismatched, "");
+  const auto moved = diagnose(mismatched, " --holdout-phase 0");
+  ASSERT_EQ(usual.exit_code, 0) << usual.err;
+  ASSERT_EQ(moved.exit_code, 0) << moved.err;
+  const auto held_out_before = [](const std::string& json) {
+    const std::string key = "\"holdout_variance_before\": ";
+    const auto at = json.find(key);
+    return at == std::string::npos ? std::string() : json.substr(at + key.size(), 12);
+  };
+  ASSERT_FALSE(held_out_before(usual.out).empty()) << usual.out;
+  ASSERT_FALSE(held_out_before(moved.out).empty()) << moved.out;
+  EXPECT_NE(held_out_before(usual.out), held_out_before(moved.out));
+  for (const char* bad : {"3", "-1", "1.5", "two"}) {
+    const auto b = diagnose(csv_, std::string(" --holdout-phase ") + bad);
+    EXPECT_EQ(b.exit_code, 2) << bad;
+    EXPECT_NE(b.err.find("--holdout-phase"), std::string::npos) << bad << ": " << b.err;
+  }
+}
+
 TEST_F(DiagnoseOutput, WriteErrorGivesNonZeroExit) {
   const int to_full = std::system(
       (kMpm + " diagnose --quiet --plant " + kWoodBerry + " --data " + csv_ + " >/dev/full 2>/dev/null").c_str());

@@ -6,14 +6,17 @@
 // other way round: a changed disturbance model whose evidence the held-out
 // blocks happen to hold more of than the fit blocks is named on the two
 // parts' evidence pooled, as every other candidate is.
+#include <algorithm>
 #include <cstddef>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "core/chi_square.hpp"
 #include "core/diagnosis.hpp"
+#include "core/diagnosis_context.hpp"
 #include "support/diagnosis_problem.hpp"
 
 namespace {
@@ -66,6 +69,53 @@ TEST(DiagnosisHoldout, LimitReachedOnlyInAFittedEpisodeIsNamed) {
   }
 }
 
+// Settings::holdout_phase moves the held-out third of the ten blocks: under
+// phase p the held-out samples are those of the blocks b with b % 3 == p
+// (the tenth block counted with the ninth), the three phases' held-out parts
+// partition the usable samples, and the same episode in block 0 is named
+// where that block is fitted and not where it is held out (then the fit part
+// holds no crossing of the limit to fit).
+TEST(DiagnosisHoldout, ThePhaseChoosesWhichBlocksAreHeldOut) {
+  ASSERT_EQ(dg::Settings{}.holdout_phase, 2);
+  const dg::Problem p = episode_problem(1, 120);
+  const auto n = static_cast<std::size_t>(p.residual.rows());
+  std::vector<int> times_held(n, 0);
+  std::size_t usable = 0;
+  for (int phase = 0; phase <= 2; ++phase) {
+    dg::Settings settings;
+    settings.holdout_phase = phase;
+    const dg::Context cx = dg::prepare(p, settings);
+    const auto first = static_cast<std::size_t>(cx.seg.begin);
+    ASSERT_LT(first, n / 10);
+    const std::size_t block = (n - first) / 10;
+    std::size_t here = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      ASSERT_FALSE(cx.seg.fit[k] && cx.seg.hold[k]) << k;
+      if (!cx.seg.fit[k] && !cx.seg.hold[k]) continue;
+      ++here;
+      const bool held = static_cast<int>(std::min<std::size_t>(9, (k - first) / block) % 3) == phase;
+      ASSERT_EQ(static_cast<bool>(cx.seg.hold[k]), held) << "phase " << phase << ", sample " << k;
+      times_held[k] += cx.seg.hold[k];
+    }
+    if (phase > 0) {
+      EXPECT_EQ(here, usable);
+    }
+    usable = here;
+  }
+  for (std::size_t k = 0; k < n; ++k) EXPECT_LE(times_held[k], 1) << k;
+  EXPECT_EQ(static_cast<std::size_t>(std::count(times_held.begin(), times_held.end(), 1)), usable);
+
+  for (unsigned seed : {1u, 2u})
+    for (int phase = 0; phase <= 2; ++phase) {
+      dg::Settings settings;
+      settings.holdout_phase = phase;
+      const dg::Result r = dg::diagnose(episode_problem(seed, 120), settings);
+      bool saturation = false;
+      for (const auto& f : r.findings) saturation = saturation || f.physics == "saturation";
+      EXPECT_EQ(saturation, phase != 0) << "seed " << seed << ", phase " << phase << ": " << describe(r);
+    }
+}
+
 // The plant file says the disturbances are 1 / (1 - 0.8 q^-1) white noise
 // of sd 0.05; the input's channel is right, and the input moves enough that
 // a sensor lag (the changed noise model's near-alias) would show on it. The
@@ -80,7 +130,7 @@ dg::Problem noise_problem(unsigned seed) {
   Eigen::VectorXd residual(n);
   double d = 0.0;
   for (Eigen::Index k = 0; k < n; ++k) {
-    const bool held_out_block = (k / (n / 10)) % 3 == 2;
+    const bool held_out_block = (k / (n / 10)) % 3 == dg::Settings{}.holdout_phase;
     d = (held_out_block ? 0.92 : 0.83) * d + noise(rng);
     residual(k) = d;
   }
