@@ -14,7 +14,7 @@ packages=(
   libjchart2d-java xvfb xdotool imagemagick
   # the HTML report inlines dygraphs; its test renders it in headless Chromium
   libjs-dygraphs chromium python3 python3-jsonschema
-  # outside the suite: scripts/generalisation_bench.py and ../shared/tools/score.py
+  # outside the suite: the shared cases' scorer, ../shared/tools/score.py
   python3-numpy python3-yaml
 )
 missing=()
