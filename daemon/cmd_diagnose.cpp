@@ -101,7 +101,8 @@ std::string report_json(const PlantModel& plant, std::size_t samples, const Gran
                         const RecordVerdict& verdict, const diagnosis::Result& r, const diagnosis::Settings& settings) {
   std::ostringstream o;
   o << "{\n  \"schema\": \"mpm.diagnosis/1\",\n  \"samples\": " << samples << ",\n  \"alpha\": "
-    << number(settings.alpha) << ",\n  \"holdout_phase\": " << settings.holdout_phase << ",\n  \"mismatch\": " << (r.mismatch ? "true" : "false") << ",\n  \"loops\": [\n";
+    << number(settings.alpha) << ",\n  \"holdout_phase\": " << settings.holdout_phase
+    << ",\n  \"mismatch\": " << (r.mismatch ? "true" : "false") << ",\n  \"loops\": [\n";
   for (std::size_t j = 0; j < plant.n_outputs(); ++j) {
     bool loop_mismatch = verdict.loop_mismatch[j];
     for (const auto& f : r.findings)
@@ -136,7 +137,7 @@ std::string report_json(const PlantModel& plant, std::size_t samples, const Gran
 void write_products(const Args& args, const std::string& plant_path, const std::string& data_path,
                     const PlantModel& plant, const diagnosis::Problem& problem, const GrangerMonitor& monitor,
                     const RecordVerdict& verdict, const diagnosis::Result& result, const DetectorTrace& trace,
-                    double alpha) {
+                    const diagnosis::Settings& settings) {
   const auto plant_out = args.get("write-plant"), html_out = args.get("html");
   if (!plant_out && !html_out) return;
   const std::vector<std::string> inputs{plant_path, data_path};
@@ -148,7 +149,7 @@ void write_products(const Args& args, const std::string& plant_path, const std::
     if (!g_quiet) std::fprintf(stderr, "mpm diagnose: corrected plant written to %s\n", plant_out->c_str());
   }
   if (html_out) {
-    write_text_file(*html_out, report_html({plant, corrected, problem, monitor, verdict, result, plant_path, data_path, &trace, alpha}),
+    write_text_file(*html_out, report_html({plant, corrected, problem, monitor, verdict, result, plant_path, data_path, &trace, settings}),
                     inputs);
     if (!g_quiet) std::fprintf(stderr, "mpm diagnose: HTML report written to %s\n", html_out->c_str());
   }
@@ -208,7 +209,7 @@ int run(int argc, char** argv) {
       config::write_output_file(*out, json);
     else
       config::write_stdout(json);
-    write_products(args, plant_path, data_path, plant, d.problem, d.monitor, d.verdict, d.result, trace, settings.alpha);
+    write_products(args, plant_path, data_path, plant, d.problem, d.monitor, d.verdict, d.result, trace, settings);
     return 0;
   });
 }

@@ -361,8 +361,10 @@ std::string report_html(const ReportInputs& in) {
   body << "<h1>mpm diagnosis: " << esc(p.name) << "</h1>\n<p class=meta>plant <code>" << esc(in.plant_path)
        << "</code>, recording <code>" << esc(in.data_path) << "</code>, " << in.problem.du.rows()
        << " samples (the first " << in.problem.begin << " skipped as start-up transient), sample time " << num(ts)
-       << " s; false-alarm level " << num(in.alpha) << " per look (a record without mismatch gets a finding with "
-       << "probability at most " << num(healthy_finding_bound(in.alpha)) << ").</p>\n<section id=findings><h2>Findings</h2>\n";
+       << " s; false-alarm level " << num(in.settings.alpha) << " per look (a record without mismatch gets a finding "
+       << "with probability at most " << num(healthy_finding_bound(in.settings.alpha))
+       << "); hypotheses judged on the held-out blocks of phase " << in.settings.holdout_phase
+       << ".</p>\n<section id=findings><h2>Findings</h2>\n";
   if (in.result.findings.empty()) body << "<p>No mismatch found.</p>\n";
   else {
     body << "<table><tr><th>#</th><th>channels</th><th>physics</th><th>what was found</th>"

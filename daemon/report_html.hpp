@@ -60,7 +60,7 @@ struct ReportInputs {
   const diagnosis::Result& result;
   std::string plant_path, data_path;
   const DetectorTrace* trace = nullptr;  // the detector section is left out without it
-  double alpha = diagnosis::Settings{}.alpha;  // the level the diagnosis was made at
+  diagnosis::Settings settings;  // what the diagnosis was made with (its level, its held-out phase)
 };
 
 // Where the dygraphs script is read from: $MPM_DYGRAPHS_JS when set, else

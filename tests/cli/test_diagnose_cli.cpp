@@ -378,6 +378,8 @@ TEST_F(DiagnoseOutput, HoldoutPhaseIsAFlagAndOutOfRangeIsAUsageError) {
   const auto moved = diagnose(mismatched, " --holdout-phase 0");
   ASSERT_EQ(usual.exit_code, 0) << usual.err;
   ASSERT_EQ(moved.exit_code, 0) << moved.err;
+  EXPECT_NE(usual.out.find("\"holdout_phase\": 2,"), std::string::npos) << usual.out;
+  EXPECT_NE(moved.out.find("\"holdout_phase\": 0,"), std::string::npos) << moved.out;
   const auto held_out_before = [](const std::string& json) {
     const std::string key = "\"holdout_variance_before\": ";
     const auto at = json.find(key);
