@@ -103,7 +103,7 @@ struct Settings {
   // sixth and ninth tenths of the record, where every method choice was
   // judged), 0 or 1 (the blocks moved by one or two). Another phase is the
   // same method on another split: how much a result moves with it is the
-  // split's luck (docs/method.md, "Diagnosis: which physics").
+  // split's luck (docs/method.md, "The split's luck").
   int holdout_phase = 2;
   int max_extra_delay = 15;     // dead-time search range (samples)
   bool verbose = false;         // report every candidate through the progress callback

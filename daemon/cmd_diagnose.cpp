@@ -164,6 +164,7 @@ int run(int argc, char** argv) {
     g_quiet = args.flag("quiet");
     diagnosis::Settings settings;
     apply_flags(args, setting_rows(), settings);
+    settings.verbose = args.flag("verbose");
     keep_freed_columns_in_heap();
     const std::string plant_path = args.required("plant");
     const std::string data_path = args.required("data");
@@ -176,8 +177,7 @@ int run(int argc, char** argv) {
     DetectorTrace trace(plant.n_outputs(), args.get("html") ? rec.samples() : 0);
     const RecordDiagnosis d = diagnose_record(
         plant, std::move(rec),
-        {.verbose = args.flag("verbose"),
-         .progress = g_quiet ? nullptr : &progress,
+        {.progress = g_quiet ? nullptr : &progress,
          .on_sample = args.get("html") ? trace.callback() : PartSampleCallback{},
          .settings = settings});
     // A header-only or all-NaN record leaves every statistic at its prior

@@ -162,7 +162,6 @@ RecordDiagnosis diagnose_record(const PlantModel& plant, config::Recording&& rec
   rec.data.resize(0, 0);
   series = ResidualSeries{};
   diagnosis::Settings dsettings = options.settings;
-  dsettings.verbose = options.verbose;
   dsettings.threads = replay_threads(std::thread::hardware_concurrency());
   r.result = diagnosis::diagnose(r.problem, dsettings, options.progress);
   if (r.verdict.diverging) r.result.notes.push_back("the monitor finds a diverging loop: its statistics are not trusted");

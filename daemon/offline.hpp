@@ -99,13 +99,13 @@ GrangerMonitor monitor_record(const PlantModel& plant, const ResidualSeries& s, 
 // the structured hypotheses on every core. The recording's columns are
 // released before the fits run: they need only the problem's.
 struct RecordDiagnosisOptions {
-  bool verbose = false;                      // every hypothesis' statistics to `progress`
   diagnosis::Progress progress = nullptr;    // progress lines (may be empty)
   PartSampleCallback on_sample;              // the monitor after each sample (the HTML report's trace)
-  // The diagnosis' settings as the engineer set them (the rows of
-  // diagnosis::Settings::fields(); verbose and threads are this pipeline's).
-  // Its alpha is the false-alarm level per look, and the monitor's record
-  // verdict is made at kUnexplainedShare of it.
+  // The diagnosis' settings: the engineer's (the rows of
+  // diagnosis::Settings::fields()) and verbose (every hypothesis' statistics
+  // to `progress`); the pipeline sets the threads. Its alpha is the
+  // false-alarm level per look, and the monitor's record verdict is made at
+  // kUnexplainedShare of it.
   diagnosis::Settings settings;
 };
 
