@@ -527,6 +527,18 @@ def finding_visibility(run, truth):
     return sum(seen.get(o, 0.0) for o in {c[0] for c in truth["channels"]})
 
 
+def reported_word(found, truth):
+    """The word a run reports for one true finding (channels as sets of (output, input)): the truth's
+    own where a finding on one of its channels names it, else the word of the finding sharing the most
+    channels with it, else "missed"."""
+    over = [f for f in found if f["channels"] & truth["channels"]]
+    if any(f["physics"] == truth["physics"] for f in over):
+        return truth["physics"]
+    if over:
+        return max(over, key=lambda f: len(f["channels"] & truth["channels"]))["physics"]
+    return "missed"
+
+
 def score(results):
     conf = defaultdict(Counter)
     tp = fp = fn = 0
@@ -575,12 +587,7 @@ def score(results):
         for t in truth:
             n_true += 1
             over = [f for f in found if f["channels"] & t["channels"]]
-            if any(f["physics"] == t["physics"] for f in over):
-                got = t["physics"]
-            elif over:
-                got = max(over, key=lambda f: len(f["channels"] & t["channels"]))["physics"]
-            else:
-                got = "missed"
+            got = reported_word(found, t)
             conf[t["physics"]][got] += 1
             right += got == t["physics"]
             # as ../shared/tools/score.py: some overlapping finding lowers the held-out variance

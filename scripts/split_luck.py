@@ -26,10 +26,10 @@ def load(path):
 
 
 def right(run, truth):
-    """As the benchmark judges a word: a finding with the truth's word on one of its channels."""
-    channels = {tuple(c) for c in truth["channels"]}
-    return any(f["physics"] == truth["physics"] and channels & {tuple(c) for c in f["channels"]}
-               for f in run["found"])
+    """Whether the run names the truth's word, as the benchmark judges it."""
+    found = [{"physics": f["physics"], "channels": {tuple(c) for c in f["channels"]}} for f in run["found"]]
+    t = {"physics": truth["physics"], "channels": {tuple(c) for c in truth["channels"]}}
+    return bench.reported_word(found, t) == truth["physics"]
 
 
 def vote(runs):
