@@ -245,6 +245,35 @@ TEST(DiagnoseCli, GainsOnOneInputAreOneFindingButNotOverALag) {
   }
 }
 
+// An actuator that cannot go below its working point (steam valve u2 of
+// Wood-Berry stops at 12), which the controller, knowing no stop, winds
+// below it most of the time: the limit lies high in the recorded range of
+// u2, not in its lower tail, and is named as the stop it is.
+TEST(DiagnoseCli, AStopTheControllerHoldsTheInputPastIsNamed) {
+  for (int seed : {3, 4}) {
+    const std::string csv = tmp_path("stop.csv"), out = tmp_path("stop.json");
+    ASSERT_EQ(run_quietly(kMpm + " simulate --scenario wood-berry-nominal --seed " + std::to_string(seed) +
+                          " --edit u2.lower=0 --out " + csv),
+              0);
+    // The premise: the recorded input sits below the stop most of the time.
+    const std::string text = read_file(csv);
+    std::size_t rows = 0, below = 0;
+    for (std::size_t at = text.find('\n'); at != std::string::npos && at + 1 < text.size(); at = text.find('\n', at + 1)) {
+      const std::size_t u1 = text.find(',', at + 1), u2 = text.find(',', u1 + 1);
+      ++rows;
+      below += std::atof(text.c_str() + u2 + 1) < 12.0;
+    }
+    ASSERT_GT(rows, 2000u);
+    ASSERT_GT(below, rows * 3 / 4) << "seed " << seed;
+    ASSERT_EQ(run_quietly(kMpm + " diagnose --quiet --plant " + kWoodBerry + " --data " + csv + " --json " + out), 0);
+    const std::string r = read_file(out);
+    EXPECT_EQ(physics_words(r), std::set<std::string>{"saturation"}) << "seed " << seed << ":\n" << r;
+    const std::size_t at = r.find("\"lower_limit\": ");
+    ASSERT_NE(at, std::string::npos) << r;
+    EXPECT_NEAR(std::atof(r.c_str() + at + 15), 12.0, 0.3) << r;
+  }
+}
+
 // The paper's 4x4 case 4.2.4: G32, a fast channel (tau 0.11 s at a 2 s
 // sample time, so no slow pole to move to 1), gains an integrator and the
 // loop diverges. The plant is the channel followed by an integrator.
