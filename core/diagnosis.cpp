@@ -290,6 +290,66 @@ const Candidate* actuator_over_channel_lag(const Context& cx, const Candidate& b
   return pick;
 }
 
+// A transmitter lag and a changed disturbance model both colour an output's
+// residual. They differ in what the model's prediction shows (the lag
+// filters it as well, which on slow channels carries little) and in the
+// innovations: a changed disturbance model N / C (C monic, as the noise row
+// fits it) is still driven by the innovations whose variance sigma^2 the
+// plant file declares, so its one-step prediction error keeps sigma^2,
+// while a lag S = (1 - a) / (1 - a q^-1) filters them and leaves
+// (1 - a)^2 sigma^2. Where the plant file declares sigma^2, each of the two
+// is weighed with it: the fit part's log-likelihood (LR scale) with the
+// variance its hypothesis predicts, n (x - 1 - ln x) below the free fit for
+// x the variance found over the one predicted, or the variance left free
+// at AIC's cost of a parameter, whichever costs less. So the term is
+// between -2 and 0: it settles near-ties between the two (on randomised
+// sensor lags of slow random plants the two fitted alike within 1-4 LR
+// units, the wrong way one run in five) and nothing else, and a declared
+// variance that is off can move no other choice.
+double declared_variance_term(const Context& cx, const Candidate& c) {
+  const Physics kind = c.hypothesis->physics;
+  if ((kind != Physics::sensor_dynamics && kind != Physics::disturbance_model) || c.fits.size() != 1) return 0.0;
+  const std::size_t j = c.fits[0].output;
+  const Problem& p = cx.problem;
+  if (j >= p.noise.size() || !p.noise[j] || j >= p.noise_variance.size() || !p.noise_variance[j] ||
+      !(*p.noise_variance[j] > 0.0))
+    return 0.0;
+  double predicted = *p.noise_variance[j];
+  if (kind == Physics::sensor_dynamics) {
+    const auto a = c.finding.parameters.find("sensor_lag_pole");
+    if (a == c.finding.parameters.end()) return 0.0;
+    predicted *= (1.0 - a->second) * (1.0 - a->second);
+  }
+  const double x = c.fits[0].fit.fit_var / predicted;
+  if (!(x > 0.0) || !std::isfinite(x)) return 0.0;
+  const double known = static_cast<double>(cx.seg.fit_samples()) * (x - 1.0 - std::log(x));
+  return -std::min(known, 2.0);
+}
+
+// Between a passing sensor lag and a passing changed disturbance model of
+// the same output, the one whose selection score with its declared-variance
+// term (declared_variance_term()) is higher.
+const Candidate* sensor_or_noise_change(const Context& cx, const Candidate& best, const std::vector<Candidate>& cands,
+                                        double family) {
+  const Physics kind = best.hypothesis->physics;
+  if ((kind != Physics::sensor_dynamics && kind != Physics::disturbance_model) || best.fits.size() != 1) return &best;
+  const Physics other = kind == Physics::sensor_dynamics ? Physics::disturbance_model : Physics::sensor_dynamics;
+  const std::size_t j = best.fits[0].output;
+  const Candidate* pick = &best;
+  double pick_score = selection_score(cx, best) + declared_variance_term(cx, best);
+  for (const Candidate& c : cands) {
+    if (c.hypothesis->physics != other || c.fits.size() != 1 || c.fits[0].output != j ||
+        !passes(c, cx.settings, family))
+      continue;
+    const double score_c = selection_score(cx, c) + declared_variance_term(cx, c);
+    if (score_c > pick_score) {
+      pick = &c;
+      pick_score = score_c;
+    }
+  }
+  return pick;
+}
+
 // The chosen word's form: among its candidates on the same channels (and
 // signal) that pass, the one with the best BIC on the fit part plus the
 // held-out gain. The word is chosen by the whole record's out-of-sample
@@ -386,6 +446,7 @@ Result diagnose(const Problem& problem, const Settings& settings, Progress progr
     if (!best) break;
     best = simplest_form(cx, *best, cands, family_of(*best));
     best = actuator_over_channel_lag(cx, *best, cands, family_of(*best));
+    best = sensor_or_noise_change(cx, *best, cands, family_of(*best));
     // Alternatives share the chosen one's signal, so its family.
     std::vector<std::string> alias = alternatives(cx, *best, cands, family_of(*best));
     const Candidate chosen = rebuild_chosen(cx, groups, *best);

@@ -125,7 +125,7 @@ struct Problem {
   Eigen::MatrixXd extra;     // samples x extra columns (absolute; NaN = missing)
   std::vector<std::optional<DiscreteTf>> nominal;  // output major; nullopt / zero = no channel
   std::vector<std::optional<DiscreteTf>> noise;    // per output, N when known
-  std::vector<std::optional<double>> noise_variance;
+  std::vector<std::optional<double>> noise_variance;  // per output, the variance of N's white input a, when known
   std::size_t begin = 0;           // first sample analysed (after the start-up transient)
   std::vector<bool> monitor_flag;  // per output: the monitor's verdict (mismatch)
   std::vector<std::vector<std::size_t>> monitor_located;  // per output: inputs located
