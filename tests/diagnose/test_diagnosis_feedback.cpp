@@ -71,7 +71,7 @@ dg::Problem closed_loop(const Plant& plant, unsigned seed) {
     for (int i = 0; i < 2; ++i) p.nominal.push_back(DiscreteTf{{kGain[j][i]}, {1.0, -kPole}, 1});
   for (int j = 0; j < 2; ++j) {
     p.noise.push_back(DiscreteTf{{1.0}, {1.0, -kPole}, 0});
-    p.noise_variance.push_back(kNoiseSd * kNoiseSd / (1.0 - kPole * kPole));
+    p.noise_variance.push_back(kNoiseSd * kNoiseSd);  // of the white input, as the plant format says
   }
   p.monitor_flag = {false, false};
   p.monitor_located = {{}, {}};
