@@ -306,16 +306,22 @@ const Candidate* actuator_over_channel_lag(const Context& cx, const Candidate& b
 // sensor lags of slow random plants the two fitted alike within 1-4 LR
 // units, the wrong way one run in five) and nothing else, and a declared
 // variance that is off can move no other choice.
-double declared_variance_term(const Context& cx, const Candidate& c) {
+// Whether c is one of that pair, a sensor lag or a changed disturbance
+// model, each one output's single fit.
+bool lag_or_noise_change(const Candidate& c) {
   const Physics kind = c.hypothesis->physics;
-  if ((kind != Physics::sensor_dynamics && kind != Physics::disturbance_model) || c.fits.size() != 1) return 0.0;
+  return (kind == Physics::sensor_dynamics || kind == Physics::disturbance_model) && c.fits.size() == 1;
+}
+
+double declared_variance_term(const Context& cx, const Candidate& c) {
+  if (!lag_or_noise_change(c)) return 0.0;
   const std::size_t j = c.fits[0].output;
   const Problem& p = cx.problem;
   if (j >= p.noise.size() || !p.noise[j] || j >= p.noise_variance.size() || !p.noise_variance[j] ||
       !(*p.noise_variance[j] > 0.0))
     return 0.0;
   double predicted = *p.noise_variance[j];
-  if (kind == Physics::sensor_dynamics) {
+  if (c.hypothesis->physics == Physics::sensor_dynamics) {
     const auto a = c.finding.parameters.find("sensor_lag_pole");
     if (a == c.finding.parameters.end()) return 0.0;
     predicted *= (1.0 - a->second) * (1.0 - a->second);
@@ -331,14 +337,12 @@ double declared_variance_term(const Context& cx, const Candidate& c) {
 // term (declared_variance_term()) is higher.
 const Candidate* sensor_or_noise_change(const Context& cx, const Candidate& best, const std::vector<Candidate>& cands,
                                         double family) {
-  const Physics kind = best.hypothesis->physics;
-  if ((kind != Physics::sensor_dynamics && kind != Physics::disturbance_model) || best.fits.size() != 1) return &best;
-  const Physics other = kind == Physics::sensor_dynamics ? Physics::disturbance_model : Physics::sensor_dynamics;
+  if (!lag_or_noise_change(best)) return &best;
   const std::size_t j = best.fits[0].output;
   const Candidate* pick = &best;
   double pick_score = selection_score(cx, best) + declared_variance_term(cx, best);
   for (const Candidate& c : cands) {
-    if (c.hypothesis->physics != other || c.fits.size() != 1 || c.fits[0].output != j ||
+    if (!lag_or_noise_change(c) || c.hypothesis->physics == best.hypothesis->physics || c.fits[0].output != j ||
         !passes(c, cx.settings, family))
       continue;
     const double score_c = selection_score(cx, c) + declared_variance_term(cx, c);

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "config/plant_loader.hpp"
 #include "core/diagnosis_physics.hpp"
 #include "support/cli.hpp"
 
@@ -256,15 +257,12 @@ TEST(DiagnoseCli, AStopTheControllerHoldsTheInputPastIsNamed) {
                           " --edit u2.lower=0 --out " + csv),
               0);
     // The premise: the recorded input sits below the stop most of the time.
-    const std::string text = read_file(csv);
-    std::size_t rows = 0, below = 0;
-    for (std::size_t at = text.find('\n'); at != std::string::npos && at + 1 < text.size(); at = text.find('\n', at + 1)) {
-      const std::size_t u1 = text.find(',', at + 1), u2 = text.find(',', u1 + 1);
-      ++rows;
-      below += std::atof(text.c_str() + u2 + 1) < 12.0;
-    }
-    ASSERT_GT(rows, 2000u);
-    ASSERT_GT(below, rows * 3 / 4) << "seed " << seed;
+    const mpm::config::Recording rec = mpm::config::load_recording(csv);
+    const auto u2 = rec.find("u2");
+    ASSERT_TRUE(u2.has_value());
+    const auto below = (rec.data.col(static_cast<Eigen::Index>(*u2)).array() < 12.0).count();
+    ASSERT_GT(rec.samples(), 2000u);
+    ASSERT_GT(static_cast<std::size_t>(below), rec.samples() * 3 / 4) << "seed " << seed;
     ASSERT_EQ(run_quietly(kMpm + " diagnose --quiet --plant " + kWoodBerry + " --data " + csv + " --json " + out), 0);
     const std::string r = read_file(out);
     EXPECT_EQ(physics_words(r), std::set<std::string>{"saturation"}) << "seed " << seed << ":\n" << r;
