@@ -37,6 +37,8 @@ struct OutputState {
   double fit_var = 1.0;   // whitened variance now, fit part
   double noise_change_var = 1.0;  // whitened variance, fit part, after an AR(3) change of the disturbance model alone
   double hold_var = 1.0;  // whitened variance now, held-out part
+  double cv_var = 1.0;    // whitened variance now, cross-fitted over the folds (LinearFit::cv_var)
+  Vec fold_var;           // its parts per fold (LinearFit::fold_var)
   Vec hold_error;         // whitened, mean-removed errors on the held-out part
 };
 
@@ -105,6 +107,11 @@ struct Candidate {
   double z_hold = 0.0;    // projection test on the held-out part
   double z_expected = 0.0;  // what z_hold would be on average were the correction exactly right
   double hold_gain = 0.0; // sum over outputs of ln(before / after), held-out whitened variance
+  double cv_gain = 0.0;   // the same for the cross-fitted variance (LinearFit::cv_var)
+  // Of the folds judged (LinearFit::fold_var), how many the correction
+  // improves out of sample (the sum over outputs of ln(before / after) > 0).
+  int folds_judged = 0;
+  int folds_improved = 0;
   // The held-out part's share of the samples judged (score() sets it; it
   // weights the pooled evidence, and 0 means there is none).
   double hold_share = 0.0;
@@ -152,7 +159,7 @@ struct HoldoutProjection {
   double z_expected = 0.0;  // what z would be on average were the correction exactly right
 };
 HoldoutProjection project_holdout(const Context& cx, const std::vector<std::pair<const Vec*, const Vec*>>& errors);
-// Fills lr, z_hold, hold_gain and lr_beyond_noise.
+// Fills lr, z_hold, hold_gain, cv_gain and lr_beyond_noise.
 void score(const Context& cx, Candidate& c);
 // Regressors of a change of output j's disturbance model given residual r:
 // r's first three lags (whitened, the lags of the whitened residual: AR(3)).
@@ -190,6 +197,9 @@ double pooled_level(const Settings& s, double family);
 // The fit-part limit where the held-out part is uninformative (see passes()).
 double uninformed_limit(const Settings& s, double family, int params);
 bool passes(const Candidate& c, const Settings& s, double family);
+// The out-of-sample part of passes(): the cross-fitted variance falls, over
+// the record and on most of the folds judged.
+bool improves_out_of_sample(const Candidate& c);
 // Whether terms added to a fitted form (`df` more parameters) are there:
 // their nested likelihood ratio on the fit part pooled with the held-out
 // projection z of what they change, at `level`.

@@ -30,6 +30,8 @@ void refresh(Context& cx, std::size_t j) {
   o.wd = simulate(o.whitener, o.d);
   o.fit_var = f.fit_var;
   o.hold_var = f.hold_var;
+  o.cv_var = f.cv_var;
+  o.fold_var = f.fold_var;
   o.hold_error = f.hold_error;
   o.noise_change_var = fit_output(cx, j, Vec(), noise_change_regressors(o.d)).fit.fit_var;
 }
@@ -127,10 +129,14 @@ Context prepare(const Problem& p, const Settings& s) {
   // Ten blocks; every third one (30 %) held out, from Settings::holdout_phase on.
   cx.seg.fit.assign(static_cast<std::size_t>(n), 0);
   cx.seg.hold.assign(static_cast<std::size_t>(n), 0);
+  cx.seg.fold.assign(static_cast<std::size_t>(n), -1);
   const Index block = std::max<Index>(1, (n - first) / 10);
   for (Index k = first; k < n; ++k) {
     if (!cx.valid[static_cast<std::size_t>(k)]) continue;
-    const bool held = std::min<Index>(9, (k - first) / block) % 3 == s.holdout_phase;
+    // The thirds of the blocks are the folds of the cross-fitted check.
+    const auto third = static_cast<signed char>(std::min<Index>(9, (k - first) / block) % 3);
+    cx.seg.fold[static_cast<std::size_t>(k)] = third;
+    const bool held = third == s.holdout_phase;
     (held ? cx.seg.hold : cx.seg.fit)[static_cast<std::size_t>(k)] = 1;
     ++(held ? cx.seg.hold_n : cx.seg.fit_n);
   }

@@ -209,10 +209,26 @@ void score(const Context& cx, Candidate& c) {
   c.lr = -objective(cx, c.fits);
   std::vector<std::pair<const Vec*, const Vec*>> errors;
   c.hold_gain = 0.0;
+  c.cv_gain = 0.0;
   for (const auto& f : c.fits) {
     const OutputState& o = cx.out[f.output];
     errors.push_back({&o.hold_error, &f.fit.hold_error});
     c.hold_gain += std::log(o.hold_var / f.fit.hold_var);
+    c.cv_gain += std::log(o.cv_var / f.fit.cv_var);
+  }
+  c.folds_judged = c.folds_improved = 0;
+  for (Index k = 0; k < static_cast<Index>(cx.seg.fold_runs.size()); ++k) {
+    double gain = 0.0;
+    bool judged = true;
+    for (const auto& f : c.fits) {
+      const Vec& before = cx.out[f.output].fold_var;
+      const Vec& after = f.fit.fold_var;
+      judged = judged && k < before.size() && k < after.size() && before(k) > 0.0 && after(k) > 0.0;
+      if (judged) gain += std::log(before(k) / after(k));
+    }
+    if (!judged) continue;
+    ++c.folds_judged;
+    c.folds_improved += gain > 0.0;
   }
   const HoldoutProjection h = project_holdout(cx, errors);
   c.z_hold = h.z;
@@ -288,13 +304,27 @@ double pooled_evidence_survival(double t, int params, double hold_share) {
 // fit LR past its limit carries a held-out part of z_expected ~ 3.
 // Last, the row's gate (see score() for the test against a changed
 // disturbance model, and the table's rows for who is held to it).
+// Out of sample, the correction must lower the cross-fitted variance over
+// the whole record and on most of its folds. The held-out blocks alone are
+// one draw of where the record's episodes fall: a feed-flow disturbance
+// whose moves the fit blocks happened to hold more of, or a map judged on
+// blocks where the input sat near its working level, raised their variance
+// on 42 of 373 detectable findings of 200 randomised runs; judged on every
+// fold, 21. Most of the folds, not only the sum: a form whose searched
+// parameter (a pole, a limit) was chosen on one episode would otherwise win
+// its whole cross-fitted gain on the fold that holds that episode.
+bool improves_out_of_sample(const Candidate& c) {
+  if (c.folds_judged == 0) return c.hold_gain > 0.0;
+  return c.cv_gain > 0.0 && 2 * c.folds_improved > c.folds_judged;
+}
+
 bool passes(const Candidate& c, const Settings& s, double family) {
   bool evidence = false;
   if (c.z_expected < s.holdout_informative_z) {
     evidence = c.lr >= uninformed_limit(s, family, c.test_params());
   } else {
     const bool both = c.lr >= fit_limit(s, family, c.test_params()) && c.z_hold >= s.holdout_z;
-    evidence = (both || pooled_evidence_p(c) <= pooled_level(s, family)) && c.hold_gain > 0.0;
+    evidence = (both || pooled_evidence_p(c) <= pooled_level(s, family)) && improves_out_of_sample(c);
   }
   return evidence && (c.hypothesis->gate != Gate::beyond_noise ||
                       c.lr_beyond_noise >= chi_square_quantile_upper(s.beyond_noise_level, c.params));
@@ -342,8 +372,8 @@ FitNumbers fit_numbers(const Context& cx, const Candidate& c, FitNumbers& raw) {
     const OutputState& o = cx.out[of.output];
     f.residual_variance_before += o.fit_var;
     f.residual_variance_after += of.fit.fit_var;
-    f.holdout_variance_before += o.hold_var;
-    f.holdout_variance_after += of.fit.hold_var;
+    f.holdout_variance_before += o.cv_var;
+    f.holdout_variance_after += of.fit.cv_var;
     const Vec after = o.d - of.correction;
     raw.residual_variance_before += variance(o.d, cx.seg.fit);
     raw.residual_variance_after += variance(after, cx.seg.fit);

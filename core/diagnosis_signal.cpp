@@ -201,11 +201,93 @@ std::vector<std::pair<Index, Index>> runs_of(const std::vector<char>& mask, Inde
 // (one block of every column stays in L1).
 constexpr Index kBlock = 256;
 
+// LinearFit::cv_var of the fit `fitted` (its theta and hold_var): per fold,
+// the Gram matrix of [X, y] centred at the fit part's means (mx, my) and its
+// column sums, so that the fit on the other folds is their sums, re-centred
+// at their own mean; then each fold's errors under that fit. The held-out
+// fold's other folds are the fit part: its variance is fitted.hold_var.
+double cross_fitted_variance(const Vec& target, const std::vector<const Vec*>& regressors, const Segments& seg,
+                             const Vec& mx, double my, LinearFit& fitted) {
+  const auto p = static_cast<Index>(regressors.size());
+  const auto x = [&](Index i) -> const Vec& { return *regressors[static_cast<std::size_t>(i)]; };
+  const std::size_t folds = seg.fold_runs.size();
+  std::vector<Eigen::MatrixXd> gram(folds, Eigen::MatrixXd::Zero(p + 1, p + 1));
+  std::vector<Vec> sums(folds, Vec::Zero(p + 1));
+  std::vector<Index> count(folds, 0);
+  std::vector<bool> held(folds, false);
+  Eigen::MatrixXd B(kBlock, p + 1);
+  for (std::size_t f = 0; f < folds; ++f)
+    for (const auto& [first, end] : seg.fold_runs[f]) {
+      held[f] = held[f] || seg.hold[static_cast<std::size_t>(first)];
+      count[f] += end - first;
+      for (Index k = first; k < end; k += kBlock) {
+        const Index m = std::min(kBlock, end - k);
+        for (Index i = 0; i < p; ++i) B.col(i).head(m) = x(i).segment(k, m).array() - mx(i);
+        B.col(p).head(m) = target.segment(k, m).array() - my;
+        gram[f].selfadjointView<Eigen::Lower>().rankUpdate(B.topRows(m).transpose());
+        sums[f] += B.topRows(m).colwise().sum().transpose();
+      }
+    }
+  double pooled = 0.0;
+  Index judged = 0;
+  fitted.fold_var = Vec::Zero(static_cast<Index>(folds));
+  Eigen::ArrayXd e(kBlock);
+  for (std::size_t f = 0; f < folds; ++f) {
+    if (count[f] < 2) continue;
+    if (held[f]) {
+      fitted.fold_var(static_cast<Index>(f)) = fitted.hold_var;
+      pooled += fitted.hold_var * static_cast<double>(count[f]);
+      judged += count[f];
+      continue;
+    }
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(p + 1, p + 1);
+    Vec s = Vec::Zero(p + 1);
+    Index n = 0;
+    for (std::size_t g = 0; g < folds; ++g)
+      if (g != f) {
+        G += gram[g];
+        s += sums[g];
+        n += count[g];
+      }
+    if (n < p + 2) continue;
+    const Eigen::MatrixXd full = G.selfadjointView<Eigen::Lower>();
+    const Eigen::MatrixXd centred = full - s * s.transpose() / static_cast<double>(n);
+    Vec theta = Vec::Zero(p);
+    if (p > 0) {
+      theta = centred.topLeftCorner(p, p).ldlt().solve(centred.col(p).head(p));
+      if (!theta.allFinite()) theta.setZero();
+    }
+    double h = 0.0, h2 = 0.0;
+    for (const auto& [first, end] : seg.fold_runs[f])
+      for (Index k = first; k < end; k += kBlock) {
+        const Index m = std::min(kBlock, end - k);
+        e.head(m) = target.segment(k, m).array();
+        for (Index i = 0; i < p; ++i) e.head(m) -= theta(i) * x(i).segment(k, m).array();
+        h += e.head(m).sum();
+        h2 += e.head(m).square().sum();
+      }
+    const double mean = h / static_cast<double>(count[f]);
+    const double spread = std::max(0.0, h2 - static_cast<double>(count[f]) * mean * mean);
+    fitted.fold_var(static_cast<Index>(f)) = std::max(1e-300, spread / static_cast<double>(count[f]));
+    pooled += spread;
+    judged += count[f];
+  }
+  return judged > 1 ? std::max(1e-300, pooled / static_cast<double>(judged)) : fitted.hold_var;
+}
+
 }  // namespace
 
 void Segments::index() {
   fit_runs = runs_of(fit, begin);
   hold_runs = runs_of(hold, begin);
+  fold_runs.clear();
+  for (const signed char f : fold)
+    if (f >= 0 && static_cast<std::size_t>(f) >= fold_runs.size()) fold_runs.resize(static_cast<std::size_t>(f) + 1);
+  std::vector<char> mask(fold.size());
+  for (std::size_t f = 0; f < fold_runs.size(); ++f) {
+    for (std::size_t k = 0; k < fold.size(); ++k) mask[k] = fold[k] == static_cast<signed char>(f);
+    fold_runs[f] = runs_of(mask, begin);
+  }
   indexed = true;
 }
 
@@ -295,6 +377,8 @@ LinearFit least_squares_at(const Vec& target, const std::vector<const Vec*>& reg
     out.hold_var = std::max(1e-300, h2 / static_cast<double>(nh) - mh * mh);
     for (const auto& [first, end] : hold_runs) out.hold_error.segment(first, end - first).array() -= mh;
   }
+  out.cv_var = seg.indexed && seg.fold_runs.size() > 1 ? cross_fitted_variance(target, regressors, seg, mx, my, out)
+                                                        : out.hold_var;
   return out;
 }
 

@@ -32,6 +32,11 @@ struct Segments {
   // builds them itself.
   std::vector<std::pair<Index, Index>> fit_runs;
   std::vector<std::pair<Index, Index>> hold_runs;
+  // The folds of the cross-fitted check (LinearFit::cv_var): per sample its
+  // fold, -1 where the sample is unused; the held-out part is one fold, the
+  // fit part the others. Empty: no folds (cv_var is then hold_var).
+  std::vector<signed char> fold;
+  std::vector<std::vector<std::pair<Index, Index>>> fold_runs;  // per fold, filled by index()
   bool indexed = false;
   void index();
   Index fit_samples() const { return fit_n; }
@@ -74,6 +79,13 @@ struct LinearFit {
   double fit_var = 0.0;    // error variance on the fit part
   double hold_var = 0.0;   // error variance on the held-out part (about its own mean)
   Vec hold_error;          // full length: mean-removed errors on held-out samples, 0 elsewhere
+  // Cross-fitted error variance: each fold of Segments::fold predicted by the
+  // fit on the other folds, about the fold's own mean, pooled over the folds
+  // (the held-out fold's errors are hold_error's: its other folds are the fit
+  // part). Every usable sample is judged out of sample, so an effect that
+  // comes in episodes is judged wherever its episodes fall.
+  double cv_var = 0.0;
+  Vec fold_var;  // per fold, its part of cv_var (0 for a fold too small to judge); empty without folds
 };
 // Part::fit: the fit part only (theta and fit_var; no held-out errors), for
 // the objective of a search.

@@ -394,8 +394,10 @@ TEST_F(DiagnoseOutput, AlphaIsTheReportsLevelAndOutOfRangeIsAUsageError) {
 }
 
 // The held-out phase is a flag from the settings' table: another split of
-// the same record, whose held-out blocks (and so the finding's held-out
-// variance) differ.
+// the same record, whose held-out blocks (and so the raw residual's
+// held-out variance) differ. The fit block's held-out variance before the
+// finding is cross-fitted over the three thirds of the blocks, every usable
+// sample judged, so it does not depend on which third the phase holds out.
 TEST_F(DiagnoseOutput, HoldoutPhaseIsAFlagAndOutOfRangeIsAUsageError) {
   const std::string mismatched = mpm::test::per_test_tmp_path("mpm_diag_out_", "dead_time.csv");
   ASSERT_EQ(run_quietly(kMpm + " simulate --scenario wood-berry-g12-dead-time --samples 3000 --seed 3 --out " +
@@ -407,14 +409,19 @@ TEST_F(DiagnoseOutput, HoldoutPhaseIsAFlagAndOutOfRangeIsAUsageError) {
   ASSERT_EQ(moved.exit_code, 0) << moved.err;
   EXPECT_NE(usual.out.find("\"holdout_phase\": 2,"), std::string::npos) << usual.out;
   EXPECT_NE(moved.out.find("\"holdout_phase\": 0,"), std::string::npos) << moved.out;
-  const auto held_out_before = [](const std::string& json) {
+  // The first finding's held-out variance before it, in its `block` ("fit"
+  // or "raw_residual").
+  const auto held_out_before = [](const std::string& json, const std::string& block) {
+    const auto in = json.find("\"" + block + "\": {");
     const std::string key = "\"holdout_variance_before\": ";
-    const auto at = json.find(key);
+    const auto at = in == std::string::npos ? in : json.find(key, in);
     return at == std::string::npos ? std::string() : json.substr(at + key.size(), 12);
   };
-  ASSERT_FALSE(held_out_before(usual.out).empty()) << usual.out;
-  ASSERT_FALSE(held_out_before(moved.out).empty()) << moved.out;
-  EXPECT_NE(held_out_before(usual.out), held_out_before(moved.out));
+  ASSERT_FALSE(held_out_before(usual.out, "raw_residual").empty()) << usual.out;
+  ASSERT_FALSE(held_out_before(moved.out, "raw_residual").empty()) << moved.out;
+  EXPECT_NE(held_out_before(usual.out, "raw_residual"), held_out_before(moved.out, "raw_residual"));
+  ASSERT_FALSE(held_out_before(usual.out, "fit").empty()) << usual.out;
+  EXPECT_EQ(held_out_before(usual.out, "fit"), held_out_before(moved.out, "fit"));
   for (const char* bad : {"3", "-1", "1.5", "two"}) {
     const auto b = diagnose(csv_, std::string(" --holdout-phase ") + bad);
     EXPECT_EQ(b.exit_code, 2) << bad;

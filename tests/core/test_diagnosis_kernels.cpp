@@ -77,15 +77,20 @@ TEST(DiagnosisKernels, SimulateIsDiscreteFilterBitForBit) {
 
 // Segments as prepare() makes them, with gaps (unusable samples) that split
 // the fit and held-out blocks into several runs.
-dg::Segments segments(Index n, bool index) {
+// With `folds`, also the folds of the cross-fitted check (the thirds of the
+// blocks, as prepare() makes them).
+dg::Segments segments(Index n, bool index, bool folds = false) {
   dg::Segments s;
   s.begin = 30;
   s.fit.assign(static_cast<std::size_t>(n), 0);
   s.hold.assign(static_cast<std::size_t>(n), 0);
+  if (folds) s.fold.assign(static_cast<std::size_t>(n), -1);
   const Index block = (n - s.begin) / 10;
   for (Index k = s.begin; k < n; ++k) {
     if (k % 97 == 0 || (k > 1200 && k < 1260)) continue;
-    const bool held = std::min<Index>(9, (k - s.begin) / block) % 3 == 2;
+    const auto third = static_cast<signed char>(std::min<Index>(9, (k - s.begin) / block) % 3);
+    if (folds) s.fold[static_cast<std::size_t>(k)] = third;
+    const bool held = third == 2;
     (held ? s.hold : s.fit)[static_cast<std::size_t>(k)] = 1;
     ++(held ? s.hold_n : s.fit_n);
   }
@@ -153,6 +158,63 @@ TEST(DiagnosisKernels, LeastSquaresMatchesQrOnTheFitSamples) {
     EXPECT_EQ(f.hold_var, g.hold_var);
     EXPECT_TRUE(f.theta == g.theta);
     EXPECT_TRUE(f.hold_error == g.hold_error);
+  }
+}
+
+// The cross-fitted variance against its definition: for each fold, a QR fit
+// of [1, X] on the other folds' samples, that fold's errors about their own
+// mean, pooled over the folds with their sample counts.
+TEST(DiagnosisKernels, CrossFittedVarianceIsEachFoldPredictedByTheOthers) {
+  const Index n = 3000;
+  const dg::Segments seg = segments(n, true, true);
+  ASSERT_EQ(seg.fold_runs.size(), 3u);
+  for (int p = 0; p <= 3; ++p) {
+    std::vector<VectorXd> x;
+    VectorXd y = noise(n, 300);
+    for (int i = 0; i < p; ++i) {
+      x.push_back(noise(n, 400 + static_cast<unsigned>(i)).array() + 2.0 * (i + 1));
+      // A coefficient that differs between the halves of the record: the
+      // folds' fits then differ from the fit part's.
+      for (Index k = 0; k < n; ++k) y(k) += (k < n / 2 ? 0.4 : 0.9) * x.back()(k);
+    }
+    const dg::LinearFit f = dg::least_squares(y, x, seg);
+    ASSERT_EQ(f.fold_var.size(), 3);
+    double pooled = 0.0;
+    Index judged = 0;
+    for (signed char fold = 0; fold < 3; ++fold) {
+      std::vector<Index> train, test;
+      for (Index k = 0; k < n; ++k) {
+        const signed char at = seg.fold[static_cast<std::size_t>(k)];
+        if (at < 0) continue;
+        (at == fold ? test : train).push_back(k);
+      }
+      const auto design = [&](const std::vector<Index>& rows) {
+        Eigen::MatrixXd X(static_cast<Index>(rows.size()), p + 1);
+        for (std::size_t r = 0; r < rows.size(); ++r) {
+          X(static_cast<Index>(r), 0) = 1.0;
+          for (int i = 0; i < p; ++i) X(static_cast<Index>(r), i + 1) = x[static_cast<std::size_t>(i)](rows[r]);
+        }
+        return X;
+      };
+      const auto target = [&](const std::vector<Index>& rows) {
+        VectorXd t(static_cast<Index>(rows.size()));
+        for (std::size_t r = 0; r < rows.size(); ++r) t(static_cast<Index>(r)) = y(rows[r]);
+        return t;
+      };
+      const VectorXd beta = design(train).colPivHouseholderQr().solve(target(train));
+      const VectorXd e = target(test) - design(test) * beta;
+      const double var = e.squaredNorm() / static_cast<double>(e.size()) - std::pow(e.mean(), 2);
+      EXPECT_NEAR(f.fold_var(fold), var, 1e-9 * var) << "p " << p << " fold " << int(fold);
+      pooled += var * static_cast<double>(e.size());
+      judged += e.size();
+    }
+    EXPECT_NEAR(f.cv_var, pooled / static_cast<double>(judged), 1e-9 * f.cv_var) << "p " << p;
+    // The held-out fold is predicted by the fit part: its variance is hold_var.
+    EXPECT_EQ(f.fold_var(2), f.hold_var);
+    // Without folds there is no cross-fit: cv_var is the held-out variance.
+    const dg::LinearFit g = dg::least_squares(y, x, segments(n, true, false));
+    EXPECT_EQ(g.cv_var, g.hold_var);
+    EXPECT_EQ(g.fold_var.size(), 0);
   }
 }
 

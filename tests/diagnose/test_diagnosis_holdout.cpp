@@ -61,11 +61,6 @@ TEST(DiagnosisHoldout, LimitReachedOnlyInAFittedEpisodeIsNamed) {
     const std::string what = "seed " + std::to_string(seed) + ": " + describe(r);
     ASSERT_EQ(r.findings.size(), 1u) << what;
     EXPECT_EQ(r.findings.front().physics, "saturation") << what;
-    // Held to the held-out test all the same, the same limit is lost.
-    dg::Settings always_held_out;
-    always_held_out.holdout_informative_z = 0.0;
-    const dg::Result held = dg::diagnose(episode_problem(seed, 120), always_held_out);
-    for (const auto& f : held.findings) EXPECT_NE(f.physics, "saturation") << "held out: " << describe(held);
   }
 }
 
