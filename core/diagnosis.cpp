@@ -147,9 +147,10 @@ std::string describe(const Context& cx, const Candidate& c, double family) {
   return m + "] lr " + fmt(c.lr, 4) + " (limit " + fmt(fit_limit(cx.settings, family, c.test_params()), 3) +
          ", pooled p " + fmt(pooled_evidence_p(c), 3) + " against " + fmt(pooled_level(cx.settings, family), 3) +
          ") z_hold " +
-         fmt(c.z_hold, 3) + " (expected " + fmt(c.z_expected, 3) + ") hold_gain " + fmt(c.hold_gain, 3) + " cv_gain " + fmt(c.cv_gain, 3) + " folds " +
-         std::to_string(c.folds_improved) + "/" + std::to_string(c.folds_judged) +
-         (passes(c, cx.settings, family) ? " passes" : " fails") + " beyond_noise " + fmt(c.lr_beyond_noise, 4) + " aic " + fmt(c.aic(), 4) + " selection " +
+         fmt(c.z_hold, 3) + " (expected " + fmt(c.z_expected, 3) + ") hold_gain " + fmt(c.hold_gain, 3) +
+         " cv_gain " + fmt(c.cv_gain, 3) + " folds " + std::to_string(c.folds_improved) + "/" +
+         std::to_string(c.folds_judged) + (passes(c, cx.settings, family) ? " passes" : " fails") +
+         " beyond_noise " + fmt(c.lr_beyond_noise, 4) + " aic " + fmt(c.aic(), 4) + " selection " +
          fmt(selection_score(cx, c), 4) + ": " + c.finding.summary;
 }
 

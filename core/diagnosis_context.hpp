@@ -159,7 +159,7 @@ struct HoldoutProjection {
   double z_expected = 0.0;  // what z would be on average were the correction exactly right
 };
 HoldoutProjection project_holdout(const Context& cx, const std::vector<std::pair<const Vec*, const Vec*>>& errors);
-// Fills lr, z_hold, hold_gain, cv_gain and lr_beyond_noise.
+// Fills lr, z_hold, hold_gain, cv_gain, the folds' counts and lr_beyond_noise.
 void score(const Context& cx, Candidate& c);
 // Regressors of a change of output j's disturbance model given residual r:
 // r's first three lags (whitened, the lags of the whitened residual: AR(3)).
