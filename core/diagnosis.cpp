@@ -301,16 +301,17 @@ const Candidate* actuator_over_channel_lag(const Context& cx, const Candidate& b
 // while a lag S = (1 - a) / (1 - a q^-1) filters them and leaves
 // (1 - a)^2 sigma^2. Where the plant file declares sigma^2, each of the two
 // is weighed with it: the fit part's log-likelihood (LR scale) with the
-// variance its hypothesis predicts, n (x - 1 - ln x) below the free fit for
-// x the variance found over the one predicted, or the variance left free
-// at BIC's cost of a parameter (ln n), whichever costs less. So the term
-// is between -ln n and 0: it settles near-ties between the two and nothing
-// else (on randomised sensor lags of slow random plants the two fitted
-// alike within a few LR units; of 123 such lags among 240 randomised runs
-// of the pair, a cap of 2, AIC's cost, named 113 right and ln n 120, with
-// the changed disturbance models 106 of 117 either way). A declared
-// variance that is off costs both the cap and so moves nothing: halved or
-// doubled, those 240 runs came out word for word alike with either cap.
+// error variance tied to the declaration, its parameters refitted so
+// (Candidate::tied_variance_deviance for the lag's pole; a changed
+// disturbance model's fit is already the tied one, n (x - 1 - ln x) below
+// the free fit for x the variance found over sigma^2), or the variance left
+// free at BIC's cost of a parameter (ln n), whichever costs less. So the
+// term is between -ln n and 0: it settles near-ties between the two and
+// nothing else (on randomised sensor lags of slow random plants the two
+// fitted alike within a few LR units). Of 123 such lags among 240
+// randomised runs of the pair, a cap of 2, AIC's cost, named 113 right; ln n
+// with the lag's variance taken at the free fit's pole 120; ln n with the
+// pole refitted 123; the changed disturbance models 106 of 117 each way.
 // Whether c is one of that pair, a sensor lag or a changed disturbance
 // model, each one output's single fit.
 bool lag_or_noise_change(const Candidate& c) {
@@ -325,16 +326,18 @@ double declared_variance_term(const Context& cx, const Candidate& c) {
   if (j >= p.noise.size() || !p.noise[j] || j >= p.noise_variance.size() || !p.noise_variance[j] ||
       !(*p.noise_variance[j] > 0.0))
     return 0.0;
-  double predicted = *p.noise_variance[j];
-  if (c.hypothesis->physics == Physics::sensor_dynamics) {
-    const auto a = c.finding.parameters.find("sensor_lag_pole");
-    if (a == c.finding.parameters.end()) return 0.0;
-    predicted *= (1.0 - a->second) * (1.0 - a->second);
-  }
-  const double x = c.fits[0].fit.fit_var / predicted;
-  if (!(x > 0.0) || !std::isfinite(x)) return 0.0;
   const double n = static_cast<double>(cx.seg.fit_samples());
-  const double known = n * (x - 1.0 - std::log(x));
+  double known = 0.0;
+  if (c.hypothesis->physics == Physics::sensor_dynamics) {
+    if (!c.tied_variance_deviance) return 0.0;
+    known = *c.tied_variance_deviance;
+  } else {
+    // A changed disturbance model's C is monic: its one-step error variance
+    // is sigma^2 whatever C, so the free fit's C is also the tied one's.
+    const double x = c.fits[0].fit.fit_var / *p.noise_variance[j];
+    if (!(x > 0.0) || !std::isfinite(x)) return 0.0;
+    known = n * (x - 1.0 - std::log(x));
+  }
   return -std::min(known, std::log(n));
 }
 

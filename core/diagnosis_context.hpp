@@ -118,6 +118,12 @@ struct Candidate {
   // The hypothesis fitted jointly with an AR(3) change of the disturbance
   // model, against that change alone: what it explains beyond a wrong N.
   double lr_beyond_noise = 0.0;
+  // A transmitter lag where the plant file declares the variance of the
+  // disturbances' white input: how much worse the fit part's log-likelihood
+  // (LR scale) is with the one-step error variance tied to that declaration
+  // through the lag's pole, (1 - a)^2 sigma^2, the pole refitted so, than
+  // with the variance free (fit_sensor(); declared_variance_term() weighs it).
+  std::optional<double> tied_variance_deviance;
   // A changed disturbance model (the noise row): the filter C that whitens
   // the output's residual further, the new model being N / C. Accepting the
   // candidate changes the output's whitener, not its residual.

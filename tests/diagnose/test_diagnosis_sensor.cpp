@@ -199,9 +199,10 @@ TEST(DiagnosisSensor, TheDeclaredInnovationVarianceTellsALagFromAChangedDisturba
 // of pole 0.4 on AR(0.7) disturbances, and of those disturbances' pole moved
 // to 0.8 unlagged. The free fits then differ by a few LR units either way,
 // and the declared variance decides only if the free variance costs a
-// parameter at BIC's ln n: at AIC's 2 the lag was named a changed
-// disturbance model in 15 of the 60 records (6 at ln n); the moved pole was
-// named right in all 60 both ways.
+// parameter at BIC's ln n and the lag's pole is refitted with its variance
+// tied to the declaration: at AIC's 2 the lag was named a changed
+// disturbance model in 15 of the 60 records, at ln n with the free fit's
+// pole in 6, so in none; the moved pole was named right in all 60 each way.
 TEST(DiagnosisSensor, TheDeclaredVarianceSettlesNearTiesOnRandomisedRecords) {
   constexpr double lag_pole = 0.4, noise_pole = 0.7, moved_pole = 0.8, sd = 0.1, g = 0.02;
   constexpr Eigen::Index n = 3000;
@@ -229,7 +230,7 @@ TEST(DiagnosisSensor, TheDeclaredVarianceSettlesNearTiesOnRandomisedRecords) {
         wrong += "seed " + std::to_string(seed) + " " + truth + ": " + describe(r) + "\n";
     }
   }
-  EXPECT_GE(lags_named, 51) << wrong;
+  EXPECT_GE(lags_named, 57) << wrong;
   EXPECT_GE(moved_named, 57) << wrong;
 }
 
