@@ -220,9 +220,10 @@ bool same_place(const Finding& a, const Finding& b) {
 // The words the data cannot tell from the chosen candidate: other words at
 // the same place (and signal) that pass every test and score within the
 // margin, best first, each once: an actuator lag beside one channel's extra
-// lag where the column's other channels carry too little to tell, a sensor
-// lag beside a changed disturbance model where the process part carries
-// little of it. The chosen word is not changed.
+// lag where the column's other channels carry too little to tell (or where
+// the input has no other channel), a sensor lag beside a changed
+// disturbance model where the process part carries little of it. The
+// chosen word is not changed.
 std::vector<std::string> alternatives(const Context& cx, const Candidate& best, const std::vector<Candidate>& cands,
                                       double family) {
   const double top = selection_score(cx, best);
@@ -239,6 +240,17 @@ std::vector<std::string> alternatives(const Context& cx, const Candidate& best, 
   std::vector<std::string> out;
   for (auto& n : near)
     if (std::find(out.begin(), out.end(), n.second) == out.end()) out.push_back(std::move(n.second));
+  // An input whose one modelled channel is this one: a lag of its actuator
+  // and the channel's extra lag are the same correction of G_M u, so no
+  // record tells them apart, and the table offers no actuator form there
+  // (shared_column: the prior of actuator_over_channel_lag rests on other
+  // channels not contradicting a common lag, and there are none to ask).
+  if (best.hypothesis->physics == Physics::unmodeled_dynamics && best.finding.channels.size() == 1) {
+    const std::optional<std::size_t> input = best.finding.channels[0].input;
+    std::string actuator(word(Physics::actuator_dynamics));
+    if (input && column_outputs(cx, *input).size() == 1 && std::find(out.begin(), out.end(), actuator) == out.end())
+      out.push_back(std::move(actuator));
+  }
   return out;
 }
 

@@ -6,6 +6,7 @@
 // alternative. Where the second channel is strong and has no lag, the
 // actuator's form loses its fit there, and the extra lag on the one channel
 // is named.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <random>
@@ -30,7 +31,9 @@ enum class Lag { actuator, channel_y1 };
 // through g_j q^-1 / (1 - 0.9 q^-1), g1 = 0.1 and g2 = `y2_gain`; the plant
 // lags u (actuator) or u's effect on y1 only (channel) by kLagPole; white
 // noise of sd kNoiseSd on each output.
-dg::Problem problem(Lag lag, double y2_gain, unsigned seed) {
+// Without `y2_modelled` the model has no channel u -> y2 (and y2_gain
+// should be 0).
+dg::Problem problem(Lag lag, double y2_gain, unsigned seed, bool y2_modelled = true) {
   const Eigen::Index n = 4000;
   std::mt19937 rng(seed);
   std::normal_distribution<double> level(0.0, 1.0), noise(0.0, kNoiseSd);
@@ -62,6 +65,7 @@ dg::Problem problem(Lag lag, double y2_gain, unsigned seed) {
   p.du.col(0) = du;
   p.u_abs = p.du;
   for (int j = 0; j < 2; ++j) p.nominal.push_back(DiscreteTf{{gain[j]}, {1.0, -kPole}, 1});
+  if (!y2_modelled) p.nominal[1].reset();
   p.noise = {DiscreteTf{{1.0}, {1.0}, 0}, DiscreteTf{{1.0}, {1.0}, 0}};
   p.noise_variance = {kNoiseSd * kNoiseSd, kNoiseSd * kNoiseSd};
   p.monitor_flag = {true, false};
@@ -99,6 +103,27 @@ TEST(DiagnosisActuator, AnExtraLagOnOneChannelBesideAStrongUnlaggedOneStaysTheCh
     ASSERT_EQ(f.channels.size(), 1u) << "seed " << seed << ": " << describe(r);
     EXPECT_EQ(f.channels[0].output, 0u) << "seed " << seed << ": " << describe(r);
     for (const auto& a : f.alternatives) EXPECT_NE(a, "actuator_dynamics") << "seed " << seed << ": " << describe(r);
+  }
+}
+
+// Where u drives y1 alone, its actuator's lag and an extra lag on u -> y1
+// are the same correction of the model's prediction: either truth is named
+// the channel's lag, with the actuator among its alternatives, since no
+// record could tell which.
+TEST(DiagnosisActuator, OnAnInputWithOneChannelTheActuatorIsTheChannelLagsAlternative) {
+  for (const Lag lag : {Lag::actuator, Lag::channel_y1}) {
+    for (unsigned seed = 1; seed <= 6; ++seed) {
+      const dg::Result r = dg::diagnose(problem(lag, 0.0, seed, false));
+      const std::string what = std::string(lag == Lag::actuator ? "actuator" : "channel") + " lag, seed " +
+                               std::to_string(seed) + ": " + describe(r);
+      ASSERT_EQ(r.findings.size(), 1u) << what;
+      const dg::Finding& f = r.findings.front();
+      EXPECT_EQ(f.physics, "unmodeled_dynamics") << what;
+      ASSERT_EQ(f.channels.size(), 1u) << what;
+      EXPECT_EQ(f.channels[0].output, 0u) << what;
+      EXPECT_NE(std::find(f.alternatives.begin(), f.alternatives.end(), "actuator_dynamics"), f.alternatives.end())
+          << what;
+    }
   }
 }
 
