@@ -334,10 +334,8 @@ bool lag_or_noise_change(const Candidate& c) {
 double declared_variance_term(const Context& cx, const Candidate& c) {
   if (!lag_or_noise_change(c)) return 0.0;
   const std::size_t j = c.fits[0].output;
-  const Problem& p = cx.problem;
-  if (j >= p.noise.size() || !p.noise[j] || j >= p.noise_variance.size() || !p.noise_variance[j] ||
-      !(*p.noise_variance[j] > 0.0))
-    return 0.0;
+  const std::optional<double> declared = declared_noise_variance(cx.problem, j);
+  if (!declared) return 0.0;
   const double n = static_cast<double>(cx.seg.fit_samples());
   double known = 0.0;
   if (c.hypothesis->physics == Physics::sensor_dynamics) {
@@ -346,7 +344,7 @@ double declared_variance_term(const Context& cx, const Candidate& c) {
   } else {
     // A changed disturbance model's C is monic: its one-step error variance
     // is sigma^2 whatever C, so the free fit's C is also the tied one's.
-    const double x = c.fits[0].fit.fit_var / *p.noise_variance[j];
+    const double x = c.fits[0].fit.fit_var / *declared;
     if (!(x > 0.0) || !std::isfinite(x)) return 0.0;
     known = n * (x - 1.0 - std::log(x));
   }

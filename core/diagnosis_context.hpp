@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -225,6 +226,14 @@ double pooled_evidence_p(const Candidate& c);
 // by their shares of the samples.
 double pooled_evidence_survival(double t, int params, double hold_share);
 double selection_score(const Context& cx, const Candidate& c);
+// The variance of output j's disturbances' white input as the plant file
+// declares it (with a noise model and a positive value), else nothing.
+inline std::optional<double> declared_noise_variance(const Problem& p, std::size_t j) {
+  if (j >= p.noise.size() || !p.noise[j] || j >= p.noise_variance.size() || !p.noise_variance[j] ||
+      !(*p.noise_variance[j] > 0.0))
+    return std::nullopt;
+  return p.noise_variance[j];
+}
 FitNumbers fit_numbers(const Context& cx, const Candidate& c, FitNumbers& raw);
 
 

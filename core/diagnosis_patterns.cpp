@@ -343,11 +343,9 @@ void fit_row_level_gain(const Context& cx, const Hypothesis& h, const Site& s, s
 // section. Nothing where the file declares no variance or the search finds
 // no finite shortfall.
 std::optional<double> tied_variance_deviance(const Context& cx, std::size_t j, const Vec& wstep, double v_free) {
-  const Problem& p = cx.problem;
-  if (j >= p.noise.size() || !p.noise[j] || j >= p.noise_variance.size() || !p.noise_variance[j] ||
-      !(*p.noise_variance[j] > 0.0) || !(v_free > 0.0))
-    return std::nullopt;
-  const double sigma2 = *p.noise_variance[j], n = static_cast<double>(cx.seg.fit_samples());
+  const std::optional<double> declared = declared_noise_variance(cx.problem, j);
+  if (!declared || !(v_free > 0.0)) return std::nullopt;
+  const double sigma2 = *declared, n = static_cast<double>(cx.seg.fit_samples());
   const double v0 = cx.out[j].fit_var;
   const auto shortfall = [&](double a) {
     const double predicted = (1.0 - a) * (1.0 - a) * sigma2;

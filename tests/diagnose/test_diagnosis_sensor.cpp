@@ -261,4 +261,3 @@ TEST(DiagnosisSensor, MovedDisturbancePoleIsReportedWithItsMemory) {
 }
 
 }  // namespace
-
